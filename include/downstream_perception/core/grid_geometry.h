@@ -1,0 +1,103 @@
+// Placement of a 2-D grid in a world frame: origin (lower-left corner of cell (0, 0)),
+// square cells of `resolution` metres, size_x by size_y cells, row-major (index = y * size_x + x),
+// the same layout as nav_msgs/OccupancyGrid.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <string>
+
+namespace downstream_perception {
+
+struct CellIndex {
+  int x = 0;
+  int y = 0;
+  bool operator==(const CellIndex& o) const { return x == o.x && y == o.y; }
+  bool operator!=(const CellIndex& o) const { return !(*this == o); }
+};
+
+/// Inclusive cell window [min_x, max_x] x [min_y, max_y]; empty when min > max.
+struct CellBounds {
+  int min_x = std::numeric_limits<int>::max();
+  int min_y = std::numeric_limits<int>::max();
+  int max_x = std::numeric_limits<int>::min();
+  int max_y = std::numeric_limits<int>::min();
+
+  bool empty() const { return min_x > max_x || min_y > max_y; }
+  void expand(int x, int y) {
+    if (x < min_x) min_x = x;
+    if (x > max_x) max_x = x;
+    if (y < min_y) min_y = y;
+    if (y > max_y) max_y = y;
+  }
+  void expand(const CellBounds& o) {
+    if (o.empty()) return;
+    expand(o.min_x, o.min_y);
+    expand(o.max_x, o.max_y);
+  }
+};
+
+class GridGeometry {
+ public:
+  /// Largest grid we accept (2^28 cells = 16384^2): beyond it a typo in a parameter would
+  /// silently allocate gigabytes.
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 28;
+
+  GridGeometry() = default;
+  /// Throws std::invalid_argument with a message naming the bad value.
+  GridGeometry(int size_x, int size_y, double resolution_m, double origin_x_m, double origin_y_m);
+
+  /// Empty string if the values make a valid grid, else the reason.
+  static std::string validate(int size_x, int size_y, double resolution_m, double origin_x_m,
+                              double origin_y_m);
+
+  int sizeX() const { return size_x_; }
+  int sizeY() const { return size_y_; }
+  double resolution() const { return resolution_; }
+  double originX() const { return origin_x_; }
+  double originY() const { return origin_y_; }
+  double sizeXMetres() const { return size_x_ * resolution_; }
+  double sizeYMetres() const { return size_y_ * resolution_; }
+  std::size_t cellCount() const { return static_cast<std::size_t>(size_x_) * size_y_; }
+
+  bool inBounds(int cx, int cy) const { return cx >= 0 && cy >= 0 && cx < size_x_ && cy < size_y_; }
+  std::size_t index(int cx, int cy) const {
+    return static_cast<std::size_t>(cy) * static_cast<std::size_t>(size_x_) + cx;
+  }
+  CellIndex cellOf(std::size_t index) const {
+    return {static_cast<int>(index % size_x_), static_cast<int>(index / size_x_)};
+  }
+
+  /// Cell containing a world point, by floor (an endpoint exactly on a cell edge belongs to the
+  /// cell above it; negative offsets floor toward -inf). No bounds check.
+  CellIndex worldToCellUnbounded(double wx, double wy) const {
+    return {static_cast<int>(std::floor((wx - origin_x_) / resolution_)),
+            static_cast<int>(std::floor((wy - origin_y_) / resolution_))};
+  }
+  /// Same as worldToCellUnbounded; returns false (and leaves *cell set) when outside the grid
+  /// or when the point is not finite.
+  bool worldToCell(double wx, double wy, CellIndex* cell) const;
+  /// World coordinates of a cell's centre.
+  void cellCentre(int cx, int cy, double* wx, double* wy) const {
+    *wx = origin_x_ + (cx + 0.5) * resolution_;
+    *wy = origin_y_ + (cy + 0.5) * resolution_;
+  }
+  /// Cell window covering a world box, clamped to the grid; empty if it misses the grid.
+  CellBounds worldBoxToCells(double min_x, double min_y, double max_x, double max_y) const;
+
+  bool operator==(const GridGeometry& o) const {
+    return size_x_ == o.size_x_ && size_y_ == o.size_y_ && resolution_ == o.resolution_ &&
+           origin_x_ == o.origin_x_ && origin_y_ == o.origin_y_;
+  }
+  bool operator!=(const GridGeometry& o) const { return !(*this == o); }
+
+ private:
+  int size_x_ = 0;
+  int size_y_ = 0;
+  double resolution_ = 0.05;
+  double origin_x_ = 0.0;
+  double origin_y_ = 0.0;
+};
+
+}  // namespace downstream_perception

@@ -1,0 +1,59 @@
+#include "downstream_perception/core/costmap.h"
+
+#include <algorithm>
+
+namespace downstream_perception {
+
+Costmap::Costmap(const GridGeometry& geometry, std::uint8_t default_value)
+    : default_value_(default_value) {
+  resize(geometry);
+}
+
+void Costmap::resize(const GridGeometry& geometry) {
+  geometry_ = geometry;
+  cells_.assign(geometry.cellCount(), default_value_);
+}
+
+void Costmap::reset() { std::fill(cells_.begin(), cells_.end(), default_value_); }
+
+CellBounds Costmap::clamp(const CellBounds& window) const {
+  CellBounds b;
+  if (window.empty() || geometry_.cellCount() == 0) return b;
+  b.min_x = std::max(window.min_x, 0);
+  b.min_y = std::max(window.min_y, 0);
+  b.max_x = std::min(window.max_x, geometry_.sizeX() - 1);
+  b.max_y = std::min(window.max_y, geometry_.sizeY() - 1);
+  return b.empty() ? CellBounds{} : b;
+}
+
+void Costmap::resetWindow(const CellBounds& window) {
+  const CellBounds b = clamp(window);
+  if (b.empty()) return;
+  for (int y = b.min_y; y <= b.max_y; ++y) {
+    std::uint8_t* row = cells_.data() + geometry_.index(b.min_x, y);
+    std::fill(row, row + (b.max_x - b.min_x + 1), default_value_);
+  }
+}
+
+void Costmap::shift(int dx, int dy) {
+  if (dx == 0 && dy == 0) return;
+  const int nx = geometry_.sizeX();
+  const int ny = geometry_.sizeY();
+  std::vector<std::uint8_t> shifted(cells_.size(), default_value_);
+  const int x_lo = std::max(0, dx);
+  const int x_hi = std::min(nx, nx + dx);
+  const int y_lo = std::max(0, dy);
+  const int y_hi = std::min(ny, ny + dy);
+  if (x_lo < x_hi) {
+    for (int y = y_lo; y < y_hi; ++y) {
+      const auto* src = cells_.data() + geometry_.index(x_lo, y);
+      std::copy(src, src + (x_hi - x_lo), shifted.data() + geometry_.index(x_lo - dx, y - dy));
+    }
+  }
+  cells_.swap(shifted);
+  geometry_ = GridGeometry(nx, ny, geometry_.resolution(),
+                           geometry_.originX() + dx * geometry_.resolution(),
+                           geometry_.originY() + dy * geometry_.resolution());
+}
+
+}  // namespace downstream_perception
