@@ -1,0 +1,248 @@
+// Python bindings of the ROS-free core: numpy arrays in and out, same numbers as the C++ tests.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <stdexcept>
+
+#include "downstream_perception/core/cost_values.h"
+#include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/log_odds_grid.h"
+#include "downstream_perception/core/ray_traversal.h"
+#include "downstream_perception/core/scan_integrator.h"
+#include "downstream_perception/core/se2.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+
+py::array_t<int> cellsToArray(const std::vector<CellIndex>& cells) {
+  py::array_t<int> out({static_cast<py::ssize_t>(cells.size()), py::ssize_t{2}});
+  auto a = out.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < static_cast<py::ssize_t>(cells.size()); ++i) {
+    a(i, 0) = cells[i].x;
+    a(i, 1) = cells[i].y;
+  }
+  return out;
+}
+
+py::tuple boundsToTuple(const CellBounds& b) {
+  if (b.empty()) return py::make_tuple();
+  return py::make_tuple(b.min_x, b.min_y, b.max_x, b.max_y);
+}
+
+template <class T, class F>
+py::array_t<T> gridArray(const LogOddsGrid& grid, F&& value) {
+  const GridGeometry& g = grid.geometry();
+  py::array_t<T> out({static_cast<py::ssize_t>(g.sizeY()), static_cast<py::ssize_t>(g.sizeX())});
+  T* data = out.mutable_data();
+  for (std::size_t i = 0; i < g.cellCount(); ++i) data[i] = value(i);
+  return out;
+}
+
+void checkIndex(const LogOddsGrid& grid, int x, int y) {
+  if (!grid.geometry().inBounds(x, y)) throw py::index_error("cell outside the grid");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "downstream_perception ROS-free core (C++), with numpy arrays in and out.";
+
+  // ----------------------------------------------------------------- grid geometry
+  py::class_<GridGeometry>(m, "GridGeometry",
+                           "Grid placement: size in cells, resolution (m), origin (m) of the "
+                           "lower-left corner. Arrays are indexed [y, x].")
+      .def(py::init<int, int, double, double, double>(), py::arg("size_x"), py::arg("size_y"),
+           py::arg("resolution"), py::arg("origin_x") = 0.0, py::arg("origin_y") = 0.0)
+      .def_property_readonly("size_x", &GridGeometry::sizeX)
+      .def_property_readonly("size_y", &GridGeometry::sizeY)
+      .def_property_readonly("resolution", &GridGeometry::resolution)
+      .def_property_readonly("origin_x", &GridGeometry::originX)
+      .def_property_readonly("origin_y", &GridGeometry::originY)
+      .def("world_to_cell",
+           [](const GridGeometry& g, double wx, double wy) {
+             const CellIndex c = g.worldToCellUnbounded(wx, wy);
+             return py::make_tuple(c.x, c.y);
+           },
+           "Cell (x, y) containing the point, by floor; may lie outside the grid.")
+      .def("in_bounds", &GridGeometry::inBounds)
+      .def("cell_centre", [](const GridGeometry& g, int x, int y) {
+        double wx = 0;
+        double wy = 0;
+        g.cellCentre(x, y, &wx, &wy);
+        return py::make_tuple(wx, wy);
+      })
+      .def("__repr__", [](const GridGeometry& g) {
+        return "GridGeometry(" + std::to_string(g.sizeX()) + ", " + std::to_string(g.sizeY()) +
+               ", " + std::to_string(g.resolution()) + ", " + std::to_string(g.originX()) + ", " +
+               std::to_string(g.originY()) + ")";
+      });
+
+  // ----------------------------------------------------------------- ray traversal
+  m.def("bresenham_line", [](int x0, int y0, int x1, int y1) {
+    return cellsToArray(bresenhamLine(x0, y0, x1, y1));
+  }, "Integer Bresenham cells from (x0, y0) to (x1, y1), both included; (N, 2) int array.");
+  m.def("ray_cells",
+        [](const GridGeometry& g, double x0, double y0, double x1, double y1, bool include_end) {
+          return cellsToArray(rayCells(g, x0, y0, x1, y1, include_end));
+        },
+        py::arg("geometry"), py::arg("x0"), py::arg("y0"), py::arg("x1"), py::arg("y1"),
+        py::arg("include_end") = true,
+        "Every cell the world segment crosses (Amanatides-Woo), clipped to the grid, in order.");
+
+  // ----------------------------------------------------------------- log-odds grid
+  py::class_<LogOddsConfig>(m, "LogOddsConfig")
+      .def(py::init<>())
+      .def_readwrite("p_hit", &LogOddsConfig::p_hit)
+      .def_readwrite("p_miss", &LogOddsConfig::p_miss)
+      .def_readwrite("clamp_min", &LogOddsConfig::clamp_min)
+      .def_readwrite("clamp_max", &LogOddsConfig::clamp_max)
+      .def_readwrite("occupied_threshold", &LogOddsConfig::occupied_threshold)
+      .def_readwrite("free_threshold", &LogOddsConfig::free_threshold)
+      .def("validate", &LogOddsConfig::validate, "Empty string if valid, else the reason.");
+
+  py::class_<LogOddsGrid>(m, "LogOddsGrid",
+                          "Fixed-point log-odds occupancy grid (2 bytes per cell, quantum 1/1024).")
+      .def(py::init<const GridGeometry&, const LogOddsConfig&>(), py::arg("geometry"),
+           py::arg("config") = LogOddsConfig{})
+      .def_property_readonly("geometry", &LogOddsGrid::geometry)
+      .def_property_readonly("config", &LogOddsGrid::config)
+      .def_property_readonly_static("quantum", [](py::object) { return LogOddsGrid::kQuantum; })
+      .def_property_readonly("hit_increment",
+                             [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.hitUnits()); })
+      .def_property_readonly("miss_increment",
+                             [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.missUnits()); })
+      .def("log_odds", [](const LogOddsGrid& g) {
+        return gridArray<float>(g, [&g](std::size_t i) { return static_cast<float>(g.logOdds(i)); });
+      }, "(size_y, size_x) float32 log-odds.")
+      .def("probability", [](const LogOddsGrid& g) {
+        return gridArray<float>(g, [&g](std::size_t i) { return static_cast<float>(g.probability(i)); });
+      }, "(size_y, size_x) float32 P(occupied).")
+      .def("states", [](const LogOddsGrid& g) {
+        return gridArray<std::int8_t>(g, [&g](std::size_t i) { return static_cast<std::int8_t>(g.state(i)); });
+      }, "(size_y, size_x) int8: -1 unknown, 0 free, 1 occupied (by the thresholds).")
+      .def("set_log_odds", [](LogOddsGrid& g, py::array_t<double, py::array::c_style | py::array::forcecast> values) {
+        const GridGeometry& geo = g.geometry();
+        if (values.ndim() != 2 || values.shape(0) != geo.sizeY() || values.shape(1) != geo.sizeX()) {
+          throw std::invalid_argument("expected an array of shape (size_y, size_x)");
+        }
+        const double* v = values.data();
+        for (std::size_t i = 0; i < geo.cellCount(); ++i) g.setLogOdds(i, v[i]);
+      })
+      .def("add_hit", [](LogOddsGrid& g, int x, int y) {
+        checkIndex(g, x, y);
+        return LogOddsGrid::dequantize(g.addHit(g.geometry().index(x, y)));
+      })
+      .def("add_miss", [](LogOddsGrid& g, int x, int y) {
+        checkIndex(g, x, y);
+        return LogOddsGrid::dequantize(g.addMiss(g.geometry().index(x, y)));
+      })
+      .def("cell_log_odds", [](const LogOddsGrid& g, int x, int y) {
+        checkIndex(g, x, y);
+        return g.logOdds(g.geometry().index(x, y));
+      })
+      .def("cell_probability", [](const LogOddsGrid& g, int x, int y) {
+        checkIndex(g, x, y);
+        return g.probability(g.geometry().index(x, y));
+      })
+      .def("reset", &LogOddsGrid::reset)
+      .def("shift", &LogOddsGrid::shift, py::arg("dx"), py::arg("dy"))
+      .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds)
+      .def_property_readonly("memory_bytes", &LogOddsGrid::memoryBytes);
+
+  m.def("log_odds_of", &LogOddsGrid::logOddsOf, "log(p / (1 - p))");
+  m.def("probability_of", &LogOddsGrid::probabilityOf, "1 - 1 / (1 + exp(l))");
+
+  // ----------------------------------------------------------------- scan integration
+  py::class_<ScanIntegratorConfig>(m, "ScanIntegratorConfig")
+      .def(py::init<>())
+      .def_readwrite("marking", &ScanIntegratorConfig::marking)
+      .def_readwrite("clearing", &ScanIntegratorConfig::clearing)
+      .def_readwrite("obstacle_min_range", &ScanIntegratorConfig::obstacle_min_range)
+      .def_readwrite("obstacle_max_range", &ScanIntegratorConfig::obstacle_max_range)
+      .def_readwrite("raytrace_min_range", &ScanIntegratorConfig::raytrace_min_range)
+      .def_readwrite("raytrace_max_range", &ScanIntegratorConfig::raytrace_max_range)
+      .def_readwrite("inf_is_valid", &ScanIntegratorConfig::inf_is_valid)
+      .def_readwrite("range_max_is_no_return", &ScanIntegratorConfig::range_max_is_no_return)
+      .def("validate", &ScanIntegratorConfig::validate);
+
+  py::class_<IntegrationStats>(m, "IntegrationStats")
+      .def_readonly("beams", &IntegrationStats::beams)
+      .def_readonly("beams_marked", &IntegrationStats::beams_marked)
+      .def_readonly("beams_no_return", &IntegrationStats::beams_no_return)
+      .def_readonly("beams_invalid", &IntegrationStats::beams_invalid)
+      .def_readonly("beams_beyond_obstacle_range", &IntegrationStats::beams_beyond_obstacle_range)
+      .def_readonly("cells_cleared", &IntegrationStats::cells_cleared)
+      .def_readonly("cells_marked", &IntegrationStats::cells_marked)
+      .def_readonly("cells_changed", &IntegrationStats::cells_changed)
+      .def_property_readonly("touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
+                             "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
+      .def_property_readonly("changed", [](const IntegrationStats& s) { return boundsToTuple(s.changed); })
+      .def("clear_mark_ratio", &IntegrationStats::clearMarkRatio);
+
+  py::class_<ScanIntegrator>(m, "ScanIntegrator")
+      .def(py::init<const ScanIntegratorConfig&>(), py::arg("config") = ScanIntegratorConfig{})
+      .def_property_readonly("config", &ScanIntegrator::config)
+      .def("integrate",
+           [](ScanIntegrator& self, LogOddsGrid& grid,
+              py::array_t<float, py::array::c_style | py::array::forcecast> ranges, double angle_min,
+              double angle_increment, double range_min, double range_max,
+              std::tuple<double, double, double> pose) {
+             if (ranges.ndim() != 1) throw std::invalid_argument("ranges must be 1-D");
+             LaserScanView view{ranges.data(), static_cast<std::size_t>(ranges.shape(0)),
+                                angle_min, angle_increment, range_min, range_max};
+             const Pose2D p{std::get<0>(pose), std::get<1>(pose), std::get<2>(pose)};
+             py::gil_scoped_release release;
+             return self.integrate(grid, view, p);
+           },
+           py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
+           py::arg("range_min"), py::arg("range_max"), py::arg("sensor_pose"),
+           "Integrates one LaserScan (REP-117 semantics) taken at sensor_pose = (x, y, yaw) in the "
+           "grid frame. Raises ValueError for a malformed scan header.");
+
+  // ----------------------------------------------------------------- SE(2)
+  py::class_<Pose2D>(m, "Pose2D")
+      .def(py::init<double, double, double>(), py::arg("x") = 0.0, py::arg("y") = 0.0,
+           py::arg("yaw") = 0.0)
+      .def_readwrite("x", &Pose2D::x)
+      .def_readwrite("y", &Pose2D::y)
+      .def_readwrite("yaw", &Pose2D::yaw)
+      .def("as_tuple", [](const Pose2D& p) { return py::make_tuple(p.x, p.y, p.yaw); })
+      .def("__repr__", [](const Pose2D& p) {
+        return "Pose2D(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
+               std::to_string(p.yaw) + ")";
+      });
+  m.def("compose", &compose, "a ∘ b (parent<-mid ∘ mid<-child = parent<-child)");
+  m.def("inverse", &inverse);
+  m.def("apply", [](const Pose2D& a, py::array_t<double, py::array::c_style | py::array::forcecast> points) {
+    if (points.ndim() != 2 || points.shape(1) != 2) throw std::invalid_argument("points must be (N, 2)");
+    const py::ssize_t n = points.shape(0);
+    py::array_t<double> out({n, py::ssize_t{2}});
+    const double* in = points.data();
+    double* o = out.mutable_data();
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const Point2 q = apply(a, {in[2 * i], in[2 * i + 1]});
+      o[2 * i] = q.x;
+      o[2 * i + 1] = q.y;
+    }
+    return out;
+  }, "R p + t for each row of an (N, 2) array.");
+  m.def("interpolate", &interpolate, py::arg("a"), py::arg("t_a"), py::arg("b"), py::arg("t_b"),
+        py::arg("t"), "Linear in translation, shortest arc in yaw.");
+  m.def("normalize_angle", &normalizeAngle);
+  m.def("shortest_angular_distance", &shortestAngularDistance);
+
+  // ----------------------------------------------------------------- costs
+  m.attr("FREE_SPACE") = cost::kFreeSpace;
+  m.attr("INSCRIBED_INFLATED_OBSTACLE") = cost::kInscribedInflatedObstacle;
+  m.attr("LETHAL_OBSTACLE") = cost::kLethalObstacle;
+  m.attr("NO_INFORMATION") = cost::kNoInformation;
+  m.def("occupancy_table", []() {
+    constexpr auto table = cost::occupancyTable();
+    py::array_t<std::int8_t> out(256);
+    std::copy(table.begin(), table.end(), out.mutable_data());
+    return out;
+  }, "cost (0..255) -> nav_msgs/OccupancyGrid value, costmap_2d's translation.");
+}
