@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""Simulator node: a robot drives a synthetic world with a 2-D lidar.
+
+Publishes sensor_msgs/LaserScan on `scan` (frame `laser`, stamped with the measurement time),
+tf map->odom (a drifting "localizer" correction) and odom->base_link at ~tf_rate_hz, a static
+base_link->laser, and std_msgs/Bool(True) on latched `sim_done` when the trajectory has ended (tf
+and scans go on from the final pose). Parameters: see README ("Simulator node").
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import rospy
+import tf2_ros
+from geometry_msgs.msg import TransformStamped
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool
+
+from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive
+
+
+def se2_matrix(x: float, y: float, yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, x], [s, c, y], [0.0, 0.0, 1.0]])
+
+
+def to_transform(
+    parent: str, child: str, m: np.ndarray, stamp: rospy.Time, z: float = 0.0
+) -> TransformStamped:
+    t = TransformStamped()
+    t.header.frame_id = parent
+    t.header.stamp = stamp
+    t.child_frame_id = child
+    t.transform.translation.x = float(m[0, 2])
+    t.transform.translation.y = float(m[1, 2])
+    t.transform.translation.z = z
+    yaw = math.atan2(m[1, 0], m[0, 0])
+    t.transform.rotation.z = math.sin(yaw / 2.0)
+    t.transform.rotation.w = math.cos(yaw / 2.0)
+    return t
+
+
+class SimNode:
+    def __init__(self) -> None:
+        p = rospy.get_param
+        world_name = str(p("~world", "warehouse_aisle"))
+        if world_name not in WORLDS:
+            rospy.logerr("sim: unknown ~world '%s' (choose from %s); using warehouse_aisle",
+                         world_name, sorted(WORLDS))
+            world_name = "warehouse_aisle"
+        self.world = WORLDS[world_name]()
+        speed = float(p("~speed_mps", 1.0))
+        if not math.isfinite(speed) or speed <= 0.0:
+            rospy.logerr("sim: ~speed_mps must be positive, got %s; using 1.0", speed)
+            speed = 1.0
+        self.trajectory = aisle_drive(speed)
+        self.scan_rate = max(0.1, float(p("~scan_rate_hz", 10.0)))
+        self.tf_rate = max(self.scan_rate, float(p("~tf_rate_hz", 50.0)))
+        self.lidar = Lidar(
+            LidarConfig(
+                num_beams=int(p("~num_beams", 360)),
+                range_max=float(p("~range_max_m", 30.0)),
+                noise_std_m=float(p("~noise_std_m", 0.01)),
+                dropout_prob=float(p("~dropout_prob", 0.0)),
+                seed=int(p("~seed", 0)),
+            )
+        )
+        self.laser_z = float(p("~laser_height_m", 0.2))
+        self.laser_x = float(p("~laser_x_m", 0.0))
+        self.start_delay = float(p("~start_delay_s", 1.0))
+        self.loop = bool(p("~loop", False))
+        self.frames = {k: str(p(f"~{k}_frame", d)) for k, d in
+                       (("map", "map"), ("odom", "odom"), ("base", "base_link"), ("laser", "laser"))}
+        ox, oy, oyaw = (float(v) for v in p("~odom_offset", [0.5, -0.2, 0.05]))
+        self.map_odom = se2_matrix(ox, oy, oyaw)
+        self.odom_map = np.linalg.inv(self.map_odom)
+
+        self.scan_pub = rospy.Publisher("scan", LaserScan, queue_size=10)
+        self.done_pub = rospy.Publisher("sim_done", Bool, queue_size=1, latch=True)
+        self.tf = tf2_ros.TransformBroadcaster()
+        self.static_tf = tf2_ros.StaticTransformBroadcaster()
+        self.static_tf.sendTransform(to_transform(
+            self.frames["base"], self.frames["laser"], se2_matrix(self.laser_x, 0.0, 0.0),
+            rospy.Time.now(), self.laser_z))
+        self.start = rospy.Time.now()
+        self.done = False
+        self.ticks = 0
+        self.scan_every = max(1, round(self.tf_rate / self.scan_rate))
+
+    def sim_time(self, stamp: rospy.Time) -> float:
+        t = max(0.0, (stamp - self.start).to_sec() - self.start_delay)
+        if self.loop and self.trajectory.duration > 0:
+            t = t % self.trajectory.duration
+        return t
+
+    def tick(self, _event: object = None) -> None:
+        stamp = rospy.Time.now()
+        t = self.sim_time(stamp)
+        x, y, yaw = self.trajectory.pose(t)
+        map_base = se2_matrix(x, y, yaw)
+        odom_base = self.odom_map @ map_base
+        self.tf.sendTransform([
+            to_transform(self.frames["map"], self.frames["odom"], self.map_odom, stamp),
+            to_transform(self.frames["odom"], self.frames["base"], odom_base, stamp),
+        ])
+        if self.ticks % self.scan_every == 0:
+            self.publish_scan(stamp, t, map_base)
+        self.ticks += 1
+        if not self.done and not self.loop and t >= self.trajectory.duration:
+            self.done = True
+            self.done_pub.publish(Bool(True))
+            rospy.loginfo("sim: trajectory finished after %.1f s of simulated time", t)
+
+    def publish_scan(self, stamp: rospy.Time, t: float, map_base: np.ndarray) -> None:
+        laser = map_base @ se2_matrix(self.laser_x, 0.0, 0.0)
+        pose = (float(laser[0, 2]), float(laser[1, 2]), math.atan2(laser[1, 0], laser[0, 0]))
+        c = self.lidar.config
+        msg = LaserScan()
+        msg.header.stamp = stamp
+        msg.header.frame_id = self.frames["laser"]
+        msg.angle_min = c.angle_min
+        msg.angle_increment = c.angle_increment
+        msg.angle_max = c.angle_min + (c.num_beams - 1) * c.angle_increment
+        msg.time_increment = 0.0
+        msg.scan_time = 1.0 / self.scan_rate
+        msg.range_min = c.range_min
+        msg.range_max = c.range_max
+        msg.ranges = self.lidar.scan(self.world, pose, t).tolist()
+        self.scan_pub.publish(msg)
+
+
+def main() -> None:
+    rospy.init_node("sim")
+    node = SimNode()
+    rospy.Timer(rospy.Duration(1.0 / node.tf_rate), node.tick)
+    rospy.spin()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,25 @@
+"""Pure-numpy simulation: analytic worlds, a 2-D lidar and robot trajectories."""
+
+from downstream_perception.sim.lidar import Lidar, LidarConfig
+from downstream_perception.sim.trajectory import Trajectory, aisle_drive
+from downstream_perception.sim.world import (
+    WORLDS,
+    MovingCircle,
+    World,
+    box_segments,
+    open_field,
+    warehouse_aisle,
+)
+
+__all__ = [
+    "WORLDS",
+    "Lidar",
+    "LidarConfig",
+    "MovingCircle",
+    "Trajectory",
+    "World",
+    "aisle_drive",
+    "box_segments",
+    "open_field",
+    "warehouse_aisle",
+]

@@ -1,0 +1,136 @@
+"""The simulator's rays hit where the geometry says."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from downstream_perception.sim import (
+    Lidar,
+    LidarConfig,
+    MovingCircle,
+    Trajectory,
+    World,
+    aisle_drive,
+    box_segments,
+    open_field,
+    warehouse_aisle,
+)
+from downstream_perception.sim import world as w
+
+
+def cast(world: World, origin: tuple[float, float], angle_deg: float, t: float = 0.0) -> float:
+    return float(world.raycast(np.array(origin), np.array([math.radians(angle_deg)]), 30.0, t)[0])
+
+
+def test_end_wall_and_doorway() -> None:
+    world = warehouse_aisle()
+    # From (5, 0.8) along +x: the end wall at x = 20 (0.8 m is beside the 1 m doorway).
+    assert cast(world, (5.0, 0.8), 0.0) == pytest.approx(15.0)
+    # Along y = 0 the beam leaves through the doorway: nothing behind it.
+    assert math.isinf(cast(world, (5.0, 0.0), 0.0))
+    # The open end at x = 0.
+    assert math.isinf(cast(world, (5.0, 0.0), 180.0))
+
+
+def test_shelf_walls_straight_and_diagonal() -> None:
+    world = warehouse_aisle()
+    assert cast(world, (5.0, 0.0), 90.0) == pytest.approx(w.AISLE_HALF_WIDTH_M)
+    assert cast(world, (5.0, 0.0), -90.0) == pytest.approx(w.AISLE_HALF_WIDTH_M)
+    assert cast(world, (3.0, 0.0), 45.0) == pytest.approx(1.5 * math.sqrt(2.0))
+
+
+def test_pillar_and_pallet() -> None:
+    world = warehouse_aisle()
+    px, py, pr = w.PILLARS[0]
+    # From straight above the pillar's centre line: distance = centre distance - radius.
+    assert cast(world, (px, 0.0), -90.0) == pytest.approx(abs(py) - pr)
+    # The pallet's aisle-facing face at y = 1.2 - 0.3 = 0.9.
+    cx, cy = w.PALLET_CENTRE
+    assert cast(world, (cx, 0.0), 90.0) == pytest.approx(cy - w.PALLET_HALF_M)
+    # Its near face at x = 7.7, seen along +x from inside the pallet's y band.
+    assert cast(world, (5.0, 1.2), 0.0) == pytest.approx(cx - w.PALLET_HALF_M - 5.0)
+
+
+def test_person_present_only_while_crossing() -> None:
+    world = warehouse_aisle()
+    # At t = 6 s the person is at (10, 0): seen from (5, 0) at 10 - 0.25 - 5 = 4.75 m.
+    assert cast(world, (5.0, 0.0), 0.0, t=6.0) == pytest.approx(4.75)
+    assert math.isinf(cast(world, (5.0, 0.0), 0.0, t=9.0))
+    assert math.isinf(cast(world, (5.0, 0.0), 0.0, t=3.0))
+    mover = MovingCircle(0.2, np.array([[0.0, 0.0, 0.0], [2.0, 2.0, 0.0]]))
+    assert mover.position(1.0) == pytest.approx((1.0, 0.0))
+    assert mover.position(2.5) is None
+
+
+def test_sensor_inside_a_circle_sees_through_it() -> None:
+    world = World(circles=np.array([[0.0, 0.0, 1.0]]))
+    assert math.isinf(cast(world, (0.0, 0.0), 30.0))
+
+
+def test_open_field_is_all_no_return() -> None:
+    ranges = Lidar(LidarConfig(num_beams=720)).scan(open_field(), (0.0, 0.0, 0.0))
+    assert ranges.dtype == np.float32
+    assert np.all(np.isposinf(ranges))
+
+
+def test_noise_dropouts_and_determinism() -> None:
+    world = World(segments=box_segments(0.0, 0.0, 5.0, 5.0))
+    config = LidarConfig(num_beams=3600, noise_std_m=0.05, dropout_prob=0.1, seed=7)
+    lidar = Lidar(config)
+    truth = world.raycast(np.zeros(2), lidar.angles(), 30.0)
+    ranges = lidar.scan(world, (0.0, 0.0, 0.0))
+    valid = ~np.isnan(ranges)
+    assert 0.08 < 1.0 - valid.mean() < 0.12
+    err = ranges[valid] - truth[valid]
+    assert abs(err.std() - 0.05) < 0.01
+    assert abs(err.mean()) < 0.005
+    again = Lidar(config).scan(world, (0.0, 0.0, 0.0))
+    np.testing.assert_array_equal(np.isnan(ranges), np.isnan(again))
+    np.testing.assert_array_equal(ranges[valid], again[valid])
+
+
+def test_yaw_rotates_the_scan() -> None:
+    world = World(segments=np.array([[3.0, -10.0, 3.0, 10.0]]))  # wall x = 3
+    lidar = Lidar(LidarConfig(num_beams=4, angle_min=0.0, noise_std_m=0.0))
+    r = lidar.scan(world, (0.0, 0.0, math.pi / 2))  # beam 3 (270 deg) now points along +x
+    assert r[3] == pytest.approx(3.0, abs=1e-5)
+    assert np.isinf(r[1])
+
+
+def test_occupied_cells_marks_walls_not_the_aisle() -> None:
+    world = warehouse_aisle()
+    res, ox, oy = 0.05, -2.0, -4.0
+    occ = world.occupied_cells(ox, oy, res, 480, 160)
+    row = lambda y: int(math.floor((y - oy) / res))  # noqa: E731
+    col = lambda x: int(math.floor((x - ox) / res))  # noqa: E731
+    assert occ[row(1.5), col(5.0)]
+    assert occ[row(-1.5) - 1 : row(-1.5) + 1, col(5.0)].any()
+    assert not occ[row(0.0), col(1.0) : col(19.0)].any()  # aisle centre line
+    assert occ[row(-1.25), col(12.0) + 2] or occ[row(-1.25), col(12.0) - 3]  # pillar rim
+
+
+def test_trajectory() -> None:
+    traj = aisle_drive(2.0)
+    assert traj.duration == pytest.approx(8.5)
+    assert traj.pose(0.0) == pytest.approx((1.0, 0.0, 0.0))
+    assert traj.pose(4.25) == pytest.approx((9.5, 0.0, 0.0))
+    assert traj.pose(100.0) == pytest.approx((18.0, 0.0, 0.0))
+    assert traj.velocity(1.0) == pytest.approx((2.0, 0.0, 0.0))
+    turn = Trajectory(np.array([[0, 0, 0], [1, 1, 0], [2, 1, 1], [3, 1, 1]]))
+    assert turn.pose(1.5)[2] == pytest.approx(math.pi / 2)
+    assert turn.pose(2.5)[2] == pytest.approx(math.pi / 2)  # stopped: keeps heading
+    with pytest.raises(ValueError):
+        Trajectory(np.array([[0, 0, 0]]))
+
+
+def test_many_beams_vectorised() -> None:
+    ranges = Lidar(LidarConfig(num_beams=3600)).scan(warehouse_aisle(), (5.0, 0.0, 0.3), 5.0)
+    assert ranges.shape == (3600,)
+    # No return only through the open end (x = 0) and the doorway (|y| < 0.5 at x = 20).
+    open_end = 2 * math.atan(1.5 / 5.0)
+    doorway = 2 * math.atan(0.5 / 15.0)
+    expected = 1.0 - (open_end + doorway) / (2 * math.pi)
+    assert np.isfinite(ranges).mean() == pytest.approx(expected, abs=0.002)
