@@ -1,0 +1,46 @@
+// The master grid plus the ordered list of Layer plugins that draw into it.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/core/costmap.h"
+#include "downstream_perception/layer.h"
+
+namespace downstream_perception {
+
+class LayeredCostmap {
+ public:
+  LayeredCostmap(std::string global_frame, bool track_unknown_space);
+
+  /// Resizes the master (every cell to the default value) and calls matchSize() on each layer.
+  void resizeMap(const GridGeometry& geometry);
+  void addPlugin(std::shared_ptr<Layer> plugin) { plugins_.push_back(std::move(plugin)); }
+  const std::vector<std::shared_ptr<Layer>>& plugins() const { return plugins_; }
+
+  /// One update: union of the enabled layers' bounds, reset of that window in the master, then
+  /// each enabled layer's updateCosts() in order. Returns the window that was redrawn.
+  CellBounds updateMap(double robot_x, double robot_y, double robot_yaw);
+  /// Resets the master and every layer.
+  void resetLayers();
+
+  Costmap& costmap() { return master_; }
+  const Costmap& costmap() const { return master_; }
+  /// Held by updateMap(); take it to read the master consistently from another thread.
+  std::recursive_mutex& mutex() { return mutex_; }
+  const std::string& globalFrame() const { return global_frame_; }
+  bool isTrackingUnknown() const { return track_unknown_space_; }
+  /// AND over the enabled layers.
+  bool isCurrent() const;
+
+ private:
+  std::string global_frame_;
+  bool track_unknown_space_;
+  Costmap master_;
+  std::vector<std::shared_ptr<Layer>> plugins_;
+  std::recursive_mutex mutex_;
+};
+
+}  // namespace downstream_perception

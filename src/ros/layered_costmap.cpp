@@ -1,0 +1,51 @@
+#include "downstream_perception/layered_costmap.h"
+
+#include <limits>
+
+namespace downstream_perception {
+
+LayeredCostmap::LayeredCostmap(std::string global_frame, bool track_unknown_space)
+    : global_frame_(std::move(global_frame)), track_unknown_space_(track_unknown_space) {
+  master_.setDefaultValue(track_unknown_space ? cost::kNoInformation : cost::kFreeSpace);
+}
+
+void LayeredCostmap::resizeMap(const GridGeometry& geometry) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  master_.resize(geometry);
+  for (auto& plugin : plugins_) plugin->matchSize();
+}
+
+CellBounds LayeredCostmap::updateMap(double robot_x, double robot_y, double robot_yaw) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  double min_x = std::numeric_limits<double>::max();
+  double min_y = std::numeric_limits<double>::max();
+  double max_x = std::numeric_limits<double>::lowest();
+  double max_y = std::numeric_limits<double>::lowest();
+  for (auto& plugin : plugins_) {
+    if (!plugin->isEnabled()) continue;
+    plugin->updateBounds(robot_x, robot_y, robot_yaw, &min_x, &min_y, &max_x, &max_y);
+  }
+  const CellBounds window = master_.geometry().worldBoxToCells(min_x, min_y, max_x, max_y);
+  if (window.empty()) return window;
+  master_.resetWindow(window);
+  for (auto& plugin : plugins_) {
+    if (!plugin->isEnabled()) continue;
+    plugin->updateCosts(master_, window.min_x, window.min_y, window.max_x + 1, window.max_y + 1);
+  }
+  return window;
+}
+
+void LayeredCostmap::resetLayers() {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  master_.reset();
+  for (auto& plugin : plugins_) plugin->reset();
+}
+
+bool LayeredCostmap::isCurrent() const {
+  for (const auto& plugin : plugins_) {
+    if (plugin->isEnabled() && !plugin->isCurrent()) return false;
+  }
+  return true;
+}
+
+}  // namespace downstream_perception
