@@ -13,6 +13,9 @@ std::string GridGeometry::validate(int size_x, int size_y, double resolution_m, 
     why << "resolution must be a finite positive number of metres, got " << resolution_m;
   } else if (size_x <= 0 || size_y <= 0) {
     why << "grid size must be positive, got " << size_x << " x " << size_y << " cells";
+  } else if (size_x > kMaxCellsPerAxis || size_y > kMaxCellsPerAxis) {
+    why << "grid of " << size_x << " x " << size_y << " cells exceeds the per-axis limit of "
+        << kMaxCellsPerAxis << " cells";
   } else if (static_cast<std::size_t>(size_x) * static_cast<std::size_t>(size_y) > kMaxCells) {
     why << "grid of " << size_x << " x " << size_y << " cells exceeds the limit of " << kMaxCells
         << " cells (check width/height/resolution)";

@@ -31,30 +31,36 @@ inline int stateClass(int v, int free_units, int occupied_units) {
 
 }  // namespace
 
-IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams) {
+IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
+                                std::vector<std::uint32_t>* scratch) {
   IntegrationStats stats;
   const GridGeometry& geometry = grid.geometry();
   if (geometry.cellCount() == 0) return stats;
-  // Cells updated in this scan, so their flags can be cleared afterwards (32-bit: the grid is
+  std::vector<std::uint32_t> local_scratch;
+  // Cells flagged in this scan, so the flags can be cleared afterwards (32-bit: the grid is
   // limited to 2^28 cells).
-  thread_local std::vector<std::uint32_t> touched_cells;
-  touched_cells.clear();
+  std::vector<std::uint32_t>& flagged = scratch != nullptr ? *scratch : local_scratch;
+  flagged.clear();
   std::int16_t* cells = grid.rawCells();
   const int free_units = grid.freeUnits();
   const int occupied_units = grid.occupiedUnits();
   const int lo = grid.clampMinUnits();
   const int hi = grid.clampMaxUnits();
+  // Raw (value * 2 + flag) of an unflagged cell sitting at the lower clamp: another miss cannot
+  // change it, so the clearing walk skips it without writing or flagging (the common case in
+  // free space that has been seen before, which is most of every scan).
+  const std::int16_t saturated_free_raw = static_cast<std::int16_t>(lo * 2);
 
-  // Applies delta to an unflagged cell, flags it; returns whether its state class changed.
+  // Applies delta to an unflagged cell and flags it; returns whether its state class changed.
   const auto update = [&](std::size_t i, int delta) {
-    const int old_v = (cells[i] - (cells[i] & 1)) / 2;
+    const int old_v = cells[i] / 2;  // unflagged: raw is even, the division is exact
     const int v = std::min(hi, std::max(lo, old_v + delta));
     cells[i] = static_cast<std::int16_t>(v * 2 + 1);
-    touched_cells.push_back(static_cast<std::uint32_t>(i));
+    flagged.push_back(static_cast<std::uint32_t>(i));
     return stateClass(old_v, free_units, occupied_units) != stateClass(v, free_units, occupied_units);
   };
 
-  // Pass 1: hits.
+  // Pass 1: hits. Every hit cell is flagged (even at the clamp) so no beam of this scan clears it.
   const int hit = grid.hitUnits();
   for (const BeamUpdate& beam : beams) {
     if (!beam.mark) continue;
@@ -71,9 +77,19 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     }
   }
 
-  // Pass 2: pass-throughs, skipping every cell already updated in this scan.
+  // Pass 2: pass-throughs, skipping every cell already updated in this scan. The walk moves a
+  // cell pointer (+-1 along x, +-size_x along y) and keeps its state in registers; the rare
+  // update (a cell not yet saturated free) leaves the hot loop.
   const int miss = grid.missUnits();
-  const std::size_t size_x = static_cast<std::size_t>(geometry.sizeX());
+  const std::ptrdiff_t size_x = geometry.sizeX();
+  std::size_t walked = 0;
+  const auto clearCell = [&](std::int16_t* p) {
+    const std::size_t i = static_cast<std::size_t>(p - cells);
+    if (update(i, miss)) {
+      ++stats.cells_changed;
+      stats.changed.expand(static_cast<int>(i % size_x), static_cast<int>(i / size_x));
+    }
+  };
   for (const BeamUpdate& beam : beams) {
     if (!beam.clear) continue;
     double x0 = beam.start_x;
@@ -82,21 +98,41 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     double y1 = beam.end_y;
     bool end_clipped = false;
     if (!clipSegmentToGrid(geometry, &x0, &y0, &x1, &y1, nullptr, &end_clipped)) continue;
+    const RayWalk walk(geometry, x0, y0, x1, y1);
     // The walk stays inside the box of its end cells: bound it per beam, not per cell.
-    stats.touched.expand(geometry.worldToCellUnbounded(x0, y0).x, geometry.worldToCellUnbounded(x0, y0).y);
-    stats.touched.expand(geometry.worldToCellUnbounded(x1, y1).x, geometry.worldToCellUnbounded(x1, y1).y);
-    traverseRay(geometry, x0, y0, x1, y1, beam.clear_end_cell || end_clipped, [&](int x, int y) {
-      const std::size_t i = static_cast<std::size_t>(y) * size_x + static_cast<std::size_t>(x);
-      if (cells[i] & 1) return;
-      ++stats.cells_cleared;
-      if (update(i, miss)) {
-        ++stats.cells_changed;
-        stats.changed.expand(x, y);
+    stats.touched.expand(walk.cx, walk.cy);
+    stats.touched.expand(walk.endX(), walk.endY());
+    std::int16_t* p = cells + walk.cy * size_x + walk.cx;
+    // Pointer steps: +-1 along x, +-size_x along y (see RayWalk for why this is a branch).
+    const std::ptrdiff_t dpx = walk.sx;
+    const std::ptrdiff_t dpy = walk.sy * size_x;
+    const std::int64_t esx = walk.err_step_x;
+    const std::int64_t esy = walk.err_step_y;
+    std::int64_t err = walk.err;
+    int left = walk.stepsLeft();
+    walked += static_cast<std::size_t>(left);
+    for (; left > 0; --left) {
+      const std::int16_t raw = *p;
+      // Skip cells flagged (hit or cleared in this scan) or already saturated free: one
+      // combined, almost always taken test.
+      const bool skip = (raw & 1) | (raw == saturated_free_raw);
+      if (__builtin_expect(!skip, 0)) clearCell(p);
+      if (err <= 0) {
+        p += dpx;
+        err += esx;
+      } else {
+        p += dpy;
+        err -= esy;
       }
-    });
+    }
+    if (beam.clear_end_cell || end_clipped) {
+      ++walked;
+      if (!(*p & 1) && *p != saturated_free_raw) clearCell(p);
+    }
   }
+  stats.cells_cleared = walked;
 
-  for (const std::uint32_t i : touched_cells) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
+  for (const std::uint32_t i : flagged) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
   return stats;
 }
 
@@ -141,6 +177,14 @@ ScanIntegrator::ScanIntegrator(const ScanIntegratorConfig& config) : config_(con
 void ScanIntegrator::beamFromRange(double origin_x, double origin_y, double direction_rad,
                                    double range, double range_min, double range_max,
                                    std::vector<BeamUpdate>* beams, IntegrationStats* stats) const {
+  beamFromDirection(origin_x, origin_y, std::cos(direction_rad), std::sin(direction_rad), range,
+                    range_min, range_max, beams, stats);
+}
+
+void ScanIntegrator::beamFromDirection(double origin_x, double origin_y, double c, double s,
+                                       double range, double range_min, double range_max,
+                                       std::vector<BeamUpdate>* beams,
+                                       IntegrationStats* stats) const {
   ++stats->beams;
   bool no_return = false;
   if (std::isnan(range) || range == -std::numeric_limits<double>::infinity()) {
@@ -159,8 +203,6 @@ void ScanIntegrator::beamFromRange(double origin_x, double origin_y, double dire
     return;
   }
 
-  const double c = std::cos(direction_rad);
-  const double s = std::sin(direction_rad);
   BeamUpdate beam;
   if (no_return) {
     ++stats->beams_no_return;
@@ -199,10 +241,24 @@ void ScanIntegrator::beamsFromScan(const LaserScanView& scan, const Pose2D& sens
                                    std::vector<BeamUpdate>* beams,
                                    IntegrationStats* stats) const {
   beams->reserve(beams->size() + scan.count);
+  // Beam directions by rotation recurrence (two trig calls per scan instead of two per beam);
+  // re-anchored every 256 beams so rounding cannot accumulate (error stays ~1e-15 rad).
+  const double step_c = std::cos(scan.angle_increment);
+  const double step_s = std::sin(scan.angle_increment);
+  double c = 0.0;
+  double s = 0.0;
   for (std::size_t k = 0; k < scan.count; ++k) {
-    const double angle = sensor_pose.yaw + scan.angle_min + static_cast<double>(k) * scan.angle_increment;
-    beamFromRange(sensor_pose.x, sensor_pose.y, angle, static_cast<double>(scan.ranges[k]),
-                  scan.range_min, scan.range_max, beams, stats);
+    if (k % 256 == 0) {
+      const double angle =
+          sensor_pose.yaw + scan.angle_min + static_cast<double>(k) * scan.angle_increment;
+      c = std::cos(angle);
+      s = std::sin(angle);
+    }
+    beamFromDirection(sensor_pose.x, sensor_pose.y, c, s, static_cast<double>(scan.ranges[k]),
+                      scan.range_min, scan.range_max, beams, stats);
+    const double next_c = c * step_c - s * step_s;
+    s = s * step_c + c * step_s;
+    c = next_c;
   }
 }
 
@@ -213,7 +269,7 @@ IntegrationStats ScanIntegrator::integrate(LogOddsGrid& grid, const LaserScanVie
   scratch_.clear();
   IntegrationStats decisions;
   beamsFromScan(scan, sensor_pose, &scratch_, &decisions);
-  IntegrationStats stats = integrateBeams(grid, scratch_);
+  IntegrationStats stats = integrateBeams(grid, scratch_, &flagged_scratch_);
   stats.beams = decisions.beams;
   stats.beams_invalid = decisions.beams_invalid;
   stats.beams_no_return = decisions.beams_no_return;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <sstream>
 
+#include "downstream_perception/core/log_odds_costs.h"
 #include "downstream_perception/layered_costmap.h"
 
 namespace downstream_perception {
@@ -95,7 +96,9 @@ void LogOddsObstacleLayer::integrateScan(LaserScanSource& source, const Accepted
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
     stats = source.integrator().integrate(grid_, scan.view, scan.sensor_pose);
-    dirty_.expand(stats.touched);
+    // Only cells whose state changed alter this layer's output: that is the window the master
+    // must refresh (a sensor sweeping an unchanged room costs no re-inflation downstream).
+    dirty_.expand(stats.changed);
   }
   const auto t1 = std::chrono::steady_clock::now();
   const double age = (ros::Time::now() - scan.msg->header.stamp).toSec();
@@ -122,26 +125,12 @@ void LogOddsObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, in
                                        int max_j) {
   std::lock_guard<std::mutex> lock(grid_mutex_);
   if (grid_.geometry() != master.geometry()) return;  // matchSize() pending
-  const std::uint8_t unknown_cost = track_unknown_space_ ? cost::kNoInformation : cost::kFreeSpace;
-  std::uint8_t* out = master.data();
-  const GridGeometry& g = grid_.geometry();
-  for (int y = min_j; y < max_j; ++y) {
-    for (int x = min_i; x < max_i; ++x) {
-      const std::size_t i = g.index(x, y);
-      switch (grid_.state(i)) {
-        case CellState::kOccupied:
-          out[i] = cost::kLethalObstacle;
-          break;
-        case CellState::kFree:
-          out[i] = cost::kFreeSpace;
-          break;
-        case CellState::kUnknown:
-          // costmap_2d's updateWithOverwrite: unknown never overwrites what the master holds.
-          if (unknown_cost != cost::kNoInformation) out[i] = unknown_cost;
-          break;
-      }
-    }
-  }
+  CellBounds window;
+  window.expand(min_i, min_j);
+  window.expand(max_i - 1, max_j - 1);
+  // Unknown cells write nothing when tracking unknown space: costmap_2d's updateWithOverwrite
+  // never writes NO_INFORMATION over what the master holds.
+  writeStateCosts(grid_, window, !track_unknown_space_, cost::kFreeSpace, &master);
 }
 
 void LogOddsObstacleLayer::matchSize() {

@@ -140,3 +140,32 @@ TEST(ClipSegment, ClipsToGridAndRejectsMisses) {
   ASSERT_EQ(cells.size(), 3u);
   EXPECT_EQ(cells.front().x, 0);
 }
+
+// The walker has no per-axis guards: it relies on exact fixed-point arithmetic to end in the end
+// cell. End points on cell edges and corners, axis-parallel segments lying on an edge, and every
+// direction are where a wrong tie-break would step out of the box (and out of the grid).
+TEST(TraverseRay, EndpointsOnEdgesAndCornersEndInTheEndCell) {
+  // Binary-exact resolutions, so the lattice points lie exactly on edges in double as well (at
+  // 0.05 m a point "on" an edge is 1e-16 m off it, and which side it falls is rounding).
+  for (const double res : {1.0, 0.25, 0.0625}) {
+    const GridGeometry g(40, 40, res, -1.0, 3.0);
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> lattice(2, 76);  // half-cell lattice inside the grid
+    for (int n = 0; n < 20000; ++n) {
+      const int a = lattice(rng), b = lattice(rng), c = lattice(rng);
+      const int d = n % 3 == 0 ? b : lattice(rng);  // a third lie on one horizontal line
+      const double x0 = -1.0 + 0.5 * a * res, y0 = 3.0 + 0.5 * b * res;
+      const double x1 = -1.0 + 0.5 * c * res, y1 = 3.0 + 0.5 * d * res;
+      const auto cells = rayCells(g, x0, y0, x1, y1);
+      ASSERT_FALSE(cells.empty());
+      ASSERT_EQ(cells.front(), g.worldToCellUnbounded(x0, y0));
+      ASSERT_EQ(cells.back(), g.worldToCellUnbounded(x1, y1)) << x0 << "," << y0 << " -> " << x1 << "," << y1;
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        ASSERT_TRUE(g.inBounds(cells[i].x, cells[i].y));
+        if (i > 0) {
+          ASSERT_EQ(std::abs(cells[i].x - cells[i - 1].x) + std::abs(cells[i].y - cells[i - 1].y), 1);
+        }
+      }
+    }
+  }
+}

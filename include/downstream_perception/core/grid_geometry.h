@@ -43,6 +43,8 @@ class GridGeometry {
   /// Largest grid we accept (2^28 cells = 16384^2): beyond it a typo in a parameter would
   /// silently allocate gigabytes.
   static constexpr std::size_t kMaxCells = std::size_t{1} << 28;
+  /// Per-axis limit: keeps the ray walker's 64-bit fixed-point error term from overflowing.
+  static constexpr int kMaxCellsPerAxis = 1 << 22;
 
   GridGeometry() = default;
   /// Throws std::invalid_argument with a message naming the bad value.

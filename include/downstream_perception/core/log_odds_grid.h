@@ -91,6 +91,7 @@ class LogOddsGrid {
 
   /// Raw storage (value * 2 + flag), for the integrator's inner loop only.
   std::int16_t* rawCells() { return cells_.data(); }
+  const std::int16_t* rawCells() const { return cells_.data(); }
   int occupiedUnits() const { return occupied_units_; }
   int freeUnits() const { return free_units_; }
 

@@ -52,7 +52,10 @@ struct IntegrationStats {
   std::size_t beams_no_return = 0;  ///< +Inf (or range_max when treated so) beams that cleared
   std::size_t beams_invalid = 0;    ///< NaN, -Inf, outside [range_min, range_max]
   std::size_t beams_beyond_obstacle_range = 0;  ///< returns too far (or near) to mark
-  std::size_t cells_cleared = 0;  ///< cells that received a miss update
+  /// Cells walked by clearing rays, per beam (a cell two beams cross counts twice, as in the
+  /// lesson's "a 10 m beam clears ~200 cells"). Each cell still receives at most one miss
+  /// update per scan, and none if it was hit in the same scan.
+  std::size_t cells_cleared = 0;
   std::size_t cells_marked = 0;   ///< cells that received a hit update
   std::size_t cells_changed = 0;  ///< cells whose state (free/occupied/unknown) changed
   CellBounds touched;             ///< window of every updated cell
@@ -66,8 +69,10 @@ struct IntegrationStats {
   void accumulate(const IntegrationStats& o);
 };
 
-/// Integrates one batch of beams (one scan) as described above.
-IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams);
+/// Integrates one batch of beams (one scan) as described above. `scratch` (optional) is reused
+/// between calls to avoid an allocation per scan.
+IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
+                                std::vector<std::uint32_t>* scratch = nullptr);
 
 struct ScanIntegratorConfig {
   bool marking = true;
@@ -110,6 +115,10 @@ class ScanIntegrator {
   void beamFromRange(double origin_x, double origin_y, double direction_rad, double range,
                      double range_min, double range_max, std::vector<BeamUpdate>* beams,
                      IntegrationStats* stats) const;
+  /// Same with the direction given as its unit vector (cos, sin).
+  void beamFromDirection(double origin_x, double origin_y, double cos_dir, double sin_dir,
+                         double range, double range_min, double range_max,
+                         std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
 
   /// beamsFromScan + integrateBeams. Throws std::invalid_argument if scan.validate() fails.
   /// Not thread-safe (reuses a scratch buffer): one integrator per thread.
@@ -119,6 +128,7 @@ class ScanIntegrator {
  private:
   ScanIntegratorConfig config_;
   std::vector<BeamUpdate> scratch_;
+  std::vector<std::uint32_t> flagged_scratch_;
 };
 
 }  // namespace downstream_perception
