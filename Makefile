@@ -26,8 +26,7 @@ bench: build
 	@source tools/env.sh && source_workspace && python3 scripts/bench.py --out out
 
 lint:
-	@ruff check src scripts test && ruff format --check src scripts test
-	@clang-format --dry-run --Werror $$(git ls-files '*.cpp' '*.h')
+	@tools/lint.sh
 
 clean:
 	rm -rf .ws out

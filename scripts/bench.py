@@ -27,7 +27,9 @@ def find_bench_binary() -> Path:
         candidate = Path(prefix) / "lib" / "downstream_perception" / "downstream_perception_bench"
         if candidate.is_file():
             return candidate
-    raise SystemExit("downstream_perception_bench not found: run `make build` and source the workspace")
+    raise SystemExit(
+        "downstream_perception_bench not found: run `make build` and source the workspace"
+    )
 
 
 def run_core(iters: int) -> list[dict[str, float]]:
@@ -127,7 +129,9 @@ def main() -> None:
     ]
     report = "\n".join(lines)
     (out / "bench.md").write_text(report)
-    (out / "bench.json").write_text(json.dumps({"core": core, "binding": binding, "sim": sim}, indent=2))
+    (out / "bench.json").write_text(
+        json.dumps({"core": core, "binding": binding, "sim": sim}, indent=2)
+    )
     print(report)
     print(f"bench: wrote {out / 'bench.md'}")
 

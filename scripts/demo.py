@@ -65,8 +65,14 @@ class Demo:
         log = open(self.out / "demo_launch.log", "wb")  # noqa: SIM115 (closed with the process)
         self.procs.append(
             subprocess.Popen(
-                ["roslaunch", "-p", str(port), "downstream_perception", "demo.launch",
-                 f"rviz:={'true' if self.rviz else 'false'}"],
+                [
+                    "roslaunch",
+                    "-p",
+                    str(port),
+                    "downstream_perception",
+                    "demo.launch",
+                    f"rviz:={'true' if self.rviz else 'false'}",
+                ],
                 stdout=log,
                 stderr=subprocess.STDOUT,
             )
@@ -85,7 +91,9 @@ class Demo:
                 break
             except Exception:
                 if time.time() > deadline:
-                    raise RuntimeError("the ROS master did not come up; see demo_launch.log") from None
+                    raise RuntimeError(
+                        "the ROS master did not come up; see demo_launch.log"
+                    ) from None
                 time.sleep(0.3)
         rospy.init_node("demo_report", anonymous=True, disable_signals=True)
 
@@ -124,7 +132,10 @@ class Demo:
             return None
         win = subprocess.run(
             ["xdotool", "search", "--sync", "--name", " - RViz$"],
-            capture_output=True, text=True, timeout=60, check=False,
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
         ).stdout.split()
         if not win:
             print("demo: no rviz window found; no screenshot", file=sys.stderr)

@@ -47,8 +47,11 @@ class SimNode:
         p = rospy.get_param
         world_name = str(p("~world", "warehouse_aisle"))
         if world_name not in WORLDS:
-            rospy.logerr("sim: unknown ~world '%s' (choose from %s); using warehouse_aisle",
-                         world_name, sorted(WORLDS))
+            rospy.logerr(
+                "sim: unknown ~world '%s' (choose from %s); using warehouse_aisle",
+                world_name,
+                sorted(WORLDS),
+            )
             world_name = "warehouse_aisle"
         self.world = WORLDS[world_name]()
         speed = float(p("~speed_mps", 1.0))
@@ -71,8 +74,15 @@ class SimNode:
         self.laser_x = float(p("~laser_x_m", 0.0))
         self.start_delay = float(p("~start_delay_s", 1.0))
         self.loop = bool(p("~loop", False))
-        self.frames = {k: str(p(f"~{k}_frame", d)) for k, d in
-                       (("map", "map"), ("odom", "odom"), ("base", "base_link"), ("laser", "laser"))}
+        self.frames = {
+            k: str(p(f"~{k}_frame", d))
+            for k, d in (
+                ("map", "map"),
+                ("odom", "odom"),
+                ("base", "base_link"),
+                ("laser", "laser"),
+            )
+        }
         ox, oy, oyaw = (float(v) for v in p("~odom_offset", [0.5, -0.2, 0.05]))
         self.map_odom = se2_matrix(ox, oy, oyaw)
         self.odom_map = np.linalg.inv(self.map_odom)
@@ -81,9 +91,15 @@ class SimNode:
         self.done_pub = rospy.Publisher("sim_done", Bool, queue_size=1, latch=True)
         self.tf = tf2_ros.TransformBroadcaster()
         self.static_tf = tf2_ros.StaticTransformBroadcaster()
-        self.static_tf.sendTransform(to_transform(
-            self.frames["base"], self.frames["laser"], se2_matrix(self.laser_x, 0.0, 0.0),
-            rospy.Time.now(), self.laser_z))
+        self.static_tf.sendTransform(
+            to_transform(
+                self.frames["base"],
+                self.frames["laser"],
+                se2_matrix(self.laser_x, 0.0, 0.0),
+                rospy.Time.now(),
+                self.laser_z,
+            )
+        )
         self.start = rospy.Time.now()
         self.done = False
         self.ticks = 0
@@ -101,10 +117,12 @@ class SimNode:
         x, y, yaw = self.trajectory.pose(t)
         map_base = se2_matrix(x, y, yaw)
         odom_base = self.odom_map @ map_base
-        self.tf.sendTransform([
-            to_transform(self.frames["map"], self.frames["odom"], self.map_odom, stamp),
-            to_transform(self.frames["odom"], self.frames["base"], odom_base, stamp),
-        ])
+        self.tf.sendTransform(
+            [
+                to_transform(self.frames["map"], self.frames["odom"], self.map_odom, stamp),
+                to_transform(self.frames["odom"], self.frames["base"], odom_base, stamp),
+            ]
+        )
         if self.ticks % self.scan_every == 0:
             self.publish_scan(stamp, t, map_base)
         self.ticks += 1

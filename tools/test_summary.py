@@ -1,5 +1,8 @@
 #!/usr/bin/env python3
-"""Prints one line counting test cases in JUnit XML results (catkin_test_results counts gtest twice)."""
+"""Prints one line counting the test cases in JUnit XML results.
+
+catkin_test_results counts every gtest case twice, so the closing line is counted here.
+"""
 
 from __future__ import annotations
 

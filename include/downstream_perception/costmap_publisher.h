@@ -16,8 +16,8 @@ class CostmapPublisher {
  public:
   CostmapPublisher(ros::NodeHandle& nh, const std::string& topic, std::string frame_id);
   void publish(const Costmap& costmap, const ros::Time& stamp);
-  static void toMessage(const Costmap& costmap, const std::string& frame_id,
-                        const ros::Time& stamp, nav_msgs::OccupancyGrid* msg);
+  static void toMessage(const Costmap& costmap, const std::string& frame_id, const ros::Time& stamp,
+                        nav_msgs::OccupancyGrid* msg);
 
  private:
   ros::Publisher publisher_;

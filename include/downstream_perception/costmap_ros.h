@@ -3,10 +3,10 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <pluginlib/class_loader.hpp>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include <pluginlib/class_loader.hpp>
 
 #include <memory>
 #include <mutex>
@@ -21,14 +21,14 @@ namespace downstream_perception {
 struct CostmapRosConfig {
   std::string global_frame = "map";
   std::string robot_base_frame = "base_link";
-  double update_frequency = 5.0;    ///< Hz
-  double publish_frequency = 1.0;   ///< Hz; 0 = never publish
-  double width = 10.0;              ///< m
-  double height = 10.0;             ///< m
-  double resolution = 0.05;         ///< m / cell
-  double origin_x = 0.0;            ///< m, lower-left corner in global_frame
-  double origin_y = 0.0;            ///< m
-  double transform_tolerance = 0.3; ///< s: oldest acceptable robot pose
+  double update_frequency = 5.0;     ///< Hz
+  double publish_frequency = 1.0;    ///< Hz; 0 = never publish
+  double width = 10.0;               ///< m
+  double height = 10.0;              ///< m
+  double resolution = 0.05;          ///< m / cell
+  double origin_x = 0.0;             ///< m, lower-left corner in global_frame
+  double origin_y = 0.0;             ///< m
+  double transform_tolerance = 0.3;  ///< s: oldest acceptable robot pose
   bool track_unknown_space = true;
 };
 

@@ -14,7 +14,9 @@ void Costmap::resize(const GridGeometry& geometry) {
   cells_.assign(geometry.cellCount(), default_value_);
 }
 
-void Costmap::reset() { std::fill(cells_.begin(), cells_.end(), default_value_); }
+void Costmap::reset() {
+  std::fill(cells_.begin(), cells_.end(), default_value_);
+}
 
 CellBounds Costmap::clamp(const CellBounds& window) const {
   CellBounds b;

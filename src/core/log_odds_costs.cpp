@@ -8,7 +8,8 @@ namespace downstream_perception {
 std::size_t writeStateCosts(const LogOddsGrid& grid, const CellBounds& window, bool write_unknown,
                             std::uint8_t unknown_cost, Costmap* master) {
   if (master == nullptr || !(grid.geometry() == master->geometry())) {
-    throw std::invalid_argument("writeStateCosts: the master grid's geometry differs from the layer's");
+    throw std::invalid_argument(
+        "writeStateCosts: the master grid's geometry differs from the layer's");
   }
   const CellBounds w = master->clamp(window);
   if (w.empty()) return 0;
@@ -33,7 +34,8 @@ std::size_t writeStateCosts(const LogOddsGrid& grid, const CellBounds& window, b
     } else {
       for (int x = 0; x < width; ++x) {
         const int v = in[x];
-        dst[x] = v > occupied_raw ? cost::kLethalObstacle : (v < free_raw ? cost::kFreeSpace : dst[x]);
+        dst[x] =
+            v > occupied_raw ? cost::kLethalObstacle : (v < free_raw ? cost::kFreeSpace : dst[x]);
       }
     }
   }

@@ -18,8 +18,9 @@ std::string LogOddsConfig::validate() const {
   } else if (!std::isfinite(clamp_min) || !std::isfinite(clamp_max) || clamp_min >= 0.0 ||
              clamp_max <= 0.0 || clamp_max > LogOddsGrid::kMaxLogOdds ||
              clamp_min < -LogOddsGrid::kMaxLogOdds) {
-    why << "clamp must satisfy -" << LogOddsGrid::kMaxLogOdds << " <= clamp_min < 0 < clamp_max <= "
-        << LogOddsGrid::kMaxLogOdds << ", got [" << clamp_min << ", " << clamp_max << "]";
+    why << "clamp must satisfy -" << LogOddsGrid::kMaxLogOdds
+        << " <= clamp_min < 0 < clamp_max <= " << LogOddsGrid::kMaxLogOdds << ", got [" << clamp_min
+        << ", " << clamp_max << "]";
   } else if (!std::isfinite(occupied_threshold) || !std::isfinite(free_threshold) ||
              free_threshold > occupied_threshold) {
     why << "free_threshold (" << free_threshold << ") must not exceed occupied_threshold ("
@@ -34,13 +35,17 @@ std::string LogOddsConfig::validate() const {
 
 int LogOddsGrid::quantize(double log_odds) {
   const double units = std::round(log_odds / kQuantum);
-  return static_cast<int>(std::clamp(units, -static_cast<double>(kMaxUnits),
-                                     static_cast<double>(kMaxUnits)));
+  return static_cast<int>(
+      std::clamp(units, -static_cast<double>(kMaxUnits), static_cast<double>(kMaxUnits)));
 }
 
-double LogOddsGrid::logOddsOf(double p) { return std::log(p / (1.0 - p)); }
+double LogOddsGrid::logOddsOf(double p) {
+  return std::log(p / (1.0 - p));
+}
 
-double LogOddsGrid::probabilityOf(double l) { return 1.0 - 1.0 / (1.0 + std::exp(l)); }
+double LogOddsGrid::probabilityOf(double l) {
+  return 1.0 - 1.0 / (1.0 + std::exp(l));
+}
 
 LogOddsGrid::LogOddsGrid(const GridGeometry& geometry, const LogOddsConfig& config) {
   applyConfig(config);
@@ -72,7 +77,9 @@ void LogOddsGrid::resize(const GridGeometry& geometry) {
   cells_.assign(geometry.cellCount(), 0);
 }
 
-void LogOddsGrid::reset() { std::fill(cells_.begin(), cells_.end(), 0); }
+void LogOddsGrid::reset() {
+  std::fill(cells_.begin(), cells_.end(), 0);
+}
 
 void LogOddsGrid::setLogOdds(std::size_t i, double log_odds) {
   const int v = std::clamp(quantize(log_odds), clamp_min_units_, clamp_max_units_);

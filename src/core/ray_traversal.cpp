@@ -66,8 +66,9 @@ std::vector<CellIndex> rayCells(const GridGeometry& grid, double x0, double y0, 
   std::vector<CellIndex> cells;
   bool end_clipped = false;
   if (!clipSegmentToGrid(grid, &x0, &y0, &x1, &y1, nullptr, &end_clipped)) return cells;
-  traverseRay(grid, x0, y0, x1, y1, include_end || end_clipped,
-              [&cells](int x, int y) { cells.push_back({x, y}); });
+  traverseRay(grid, x0, y0, x1, y1, include_end || end_clipped, [&cells](int x, int y) {
+    cells.push_back({x, y});
+  });
   return cells;
 }
 

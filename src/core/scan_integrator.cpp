@@ -57,7 +57,8 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     const int v = std::min(hi, std::max(lo, old_v + delta));
     cells[i] = static_cast<std::int16_t>(v * 2 + 1);
     flagged.push_back(static_cast<std::uint32_t>(i));
-    return stateClass(old_v, free_units, occupied_units) != stateClass(v, free_units, occupied_units);
+    return stateClass(old_v, free_units, occupied_units) !=
+           stateClass(v, free_units, occupied_units);
   };
 
   // Pass 1: hits. Every hit cell is flagged (even at the clamp) so no beam of this scan clears it.
@@ -163,8 +164,7 @@ std::string LaserScanView::validate() const {
     why << count << " beams of " << angle_increment << " rad span more than a full turn";
   } else if (!std::isfinite(range_min) || !std::isfinite(range_max) || range_min < 0.0 ||
              range_max <= range_min) {
-    why << "need finite 0 <= range_min < range_max, got [" << range_min << ", " << range_max
-        << "]";
+    why << "need finite 0 <= range_min < range_max, got [" << range_min << ", " << range_max << "]";
   }
   return why.str();
 }
@@ -238,8 +238,7 @@ void ScanIntegrator::beamFromDirection(double origin_x, double origin_y, double 
 }
 
 void ScanIntegrator::beamsFromScan(const LaserScanView& scan, const Pose2D& sensor_pose,
-                                   std::vector<BeamUpdate>* beams,
-                                   IntegrationStats* stats) const {
+                                   std::vector<BeamUpdate>* beams, IntegrationStats* stats) const {
   beams->reserve(beams->size() + scan.count);
   // Beam directions by rotation recurrence (two trig calls per scan instead of two per beam);
   // re-anchored every 256 beams so rounding cannot accumulate (error stays ~1e-15 rad).

@@ -25,8 +25,8 @@ constexpr double kMaxTiltRad = 10.0 * M_PI / 180.0;
 }  // namespace
 
 LaserScanSource::LaserScanSource(std::string name, const LaserScanSourceConfig& config,
-                                 ros::NodeHandle nh, tf2_ros::Buffer& tf,
-                                 std::string global_frame, Callback on_scan)
+                                 ros::NodeHandle nh, tf2_ros::Buffer& tf, std::string global_frame,
+                                 Callback on_scan)
     : name_(std::move(name)),
       config_(config),
       nh_(nh),
@@ -37,16 +37,17 @@ LaserScanSource::LaserScanSource(std::string name, const LaserScanSourceConfig& 
   if (config_.topic.empty()) config_.topic = name_;
 }
 
-LaserScanSource::~LaserScanSource() { unsubscribe(); }
+LaserScanSource::~LaserScanSource() {
+  unsubscribe();
+}
 
 void LaserScanSource::subscribe() {
   if (subscriber_) return;
-  subscriber_ = std::make_unique<message_filters::Subscriber<sensor_msgs::LaserScan>>(
-      nh_, config_.topic, 50);
+  subscriber_ =
+      std::make_unique<message_filters::Subscriber<sensor_msgs::LaserScan>>(nh_, config_.topic, 50);
   filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::LaserScan>>(
       *subscriber_, tf_, global_frame_, static_cast<std::uint32_t>(config_.tf_queue_size), nh_);
-  filter_->registerCallback(
-      boost::bind(&LaserScanSource::onScan, this, boost::placeholders::_1));
+  filter_->registerCallback(boost::bind(&LaserScanSource::onScan, this, boost::placeholders::_1));
   filter_->registerFailureCallback(boost::bind(&LaserScanSource::onTfFailure, this,
                                                boost::placeholders::_1, boost::placeholders::_2));
 }
@@ -91,8 +92,8 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
   }
   AcceptedScan scan;
   scan.msg = msg;
-  scan.view = LaserScanView{msg->ranges.data(), msg->ranges.size(),   msg->angle_min,
-                            msg->angle_increment, msg->range_min, msg->range_max};
+  scan.view = LaserScanView{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
+                            msg->angle_increment, msg->range_min,     msg->range_max};
   std::string why = scan.view.validate();
   if (why.empty() && std::isfinite(msg->angle_max)) {
     const double expected = (msg->angle_max - msg->angle_min) / msg->angle_increment + 1.0;
@@ -107,8 +108,8 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
     return;
   }
 
-  const std::string& frame = config_.sensor_frame.empty() ? msg->header.frame_id
-                                                          : config_.sensor_frame;
+  const std::string& frame =
+      config_.sensor_frame.empty() ? msg->header.frame_id : config_.sensor_frame;
   geometry_msgs::TransformStamped t;
   try {
     t = tf_.lookupTransform(global_frame_, frame, msg->header.stamp);
@@ -121,7 +122,8 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
   // The scan plane's normal must be (anti)parallel to the global z axis.
   if (std::abs(r[2][2]) < std::cos(kMaxTiltRad)) {
     std::ostringstream s;
-    s << "sensor frame '" << frame << "' is tilted " << std::acos(std::min(1.0, std::abs(r[2][2]))) * 180.0 / M_PI
+    s << "sensor frame '" << frame << "' is tilted "
+      << std::acos(std::min(1.0, std::abs(r[2][2]))) * 180.0 / M_PI
       << " deg from horizontal (limit " << kMaxTiltRad * 180.0 / M_PI << " deg)";
     reject("bad pose: sensor tilted", s.str());
     return;

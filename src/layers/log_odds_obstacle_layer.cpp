@@ -80,10 +80,13 @@ void LogOddsObstacleLayer::readSources() {
     }
     sources_.push_back(std::make_unique<LaserScanSource>(
         name, config, nh_, *tf_, layered_costmap_->globalFrame(),
-        [this](LaserScanSource& source, const AcceptedScan& scan) { integrateScan(source, scan); }));
+        [this](LaserScanSource& source, const AcceptedScan& scan) {
+          integrateScan(source, scan);
+        }));
     ROS_INFO("layer '%s': source '%s' on %s (mark <= %.2f m, clear <= %.2f m, inf_is_valid %s)",
-             name_.c_str(), name.c_str(), ros::names::resolve(nh_.getNamespace(), config.topic).c_str(),
-             ic.obstacle_max_range, ic.raytrace_max_range, ic.inf_is_valid ? "true" : "false");
+             name_.c_str(), name.c_str(),
+             ros::names::resolve(nh_.getNamespace(), config.topic).c_str(), ic.obstacle_max_range,
+             ic.raytrace_max_range, ic.inf_is_valid ? "true" : "false");
   }
   if (sources_.empty()) {
     ROS_WARN("layer '%s': no usable observation_sources; the layer will stay empty", name_.c_str());

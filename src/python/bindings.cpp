@@ -61,19 +61,21 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("resolution", &GridGeometry::resolution)
       .def_property_readonly("origin_x", &GridGeometry::originX)
       .def_property_readonly("origin_y", &GridGeometry::originY)
-      .def("world_to_cell",
-           [](const GridGeometry& g, double wx, double wy) {
-             const CellIndex c = g.worldToCellUnbounded(wx, wy);
-             return py::make_tuple(c.x, c.y);
-           },
-           "Cell (x, y) containing the point, by floor; may lie outside the grid.")
+      .def(
+          "world_to_cell",
+          [](const GridGeometry& g, double wx, double wy) {
+            const CellIndex c = g.worldToCellUnbounded(wx, wy);
+            return py::make_tuple(c.x, c.y);
+          },
+          "Cell (x, y) containing the point, by floor; may lie outside the grid.")
       .def("in_bounds", &GridGeometry::inBounds)
-      .def("cell_centre", [](const GridGeometry& g, int x, int y) {
-        double wx = 0;
-        double wy = 0;
-        g.cellCentre(x, y, &wx, &wy);
-        return py::make_tuple(wx, wy);
-      })
+      .def("cell_centre",
+           [](const GridGeometry& g, int x, int y) {
+             double wx = 0;
+             double wy = 0;
+             g.cellCentre(x, y, &wx, &wy);
+             return py::make_tuple(wx, wy);
+           })
       .def("__repr__", [](const GridGeometry& g) {
         return "GridGeometry(" + std::to_string(g.sizeX()) + ", " + std::to_string(g.sizeY()) +
                ", " + std::to_string(g.resolution()) + ", " + std::to_string(g.originX()) + ", " +
@@ -81,16 +83,18 @@ PYBIND11_MODULE(_core, m) {
       });
 
   // ----------------------------------------------------------------- ray traversal
-  m.def("bresenham_line", [](int x0, int y0, int x1, int y1) {
-    return cellsToArray(bresenhamLine(x0, y0, x1, y1));
-  }, "Integer Bresenham cells from (x0, y0) to (x1, y1), both included; (N, 2) int array.");
-  m.def("ray_cells",
-        [](const GridGeometry& g, double x0, double y0, double x1, double y1, bool include_end) {
-          return cellsToArray(rayCells(g, x0, y0, x1, y1, include_end));
-        },
-        py::arg("geometry"), py::arg("x0"), py::arg("y0"), py::arg("x1"), py::arg("y1"),
-        py::arg("include_end") = true,
-        "Every cell the world segment crosses (Amanatides-Woo), clipped to the grid, in order.");
+  m.def(
+      "bresenham_line",
+      [](int x0, int y0, int x1, int y1) { return cellsToArray(bresenhamLine(x0, y0, x1, y1)); },
+      "Integer Bresenham cells from (x0, y0) to (x1, y1), both included; (N, 2) int array.");
+  m.def(
+      "ray_cells",
+      [](const GridGeometry& g, double x0, double y0, double x1, double y1, bool include_end) {
+        return cellsToArray(rayCells(g, x0, y0, x1, y1, include_end));
+      },
+      py::arg("geometry"), py::arg("x0"), py::arg("y0"), py::arg("x1"), py::arg("y1"),
+      py::arg("include_end") = true,
+      "Every cell the world segment crosses (Amanatides-Woo), clipped to the grid, in order.");
 
   // ----------------------------------------------------------------- log-odds grid
   py::class_<LogOddsConfig>(m, "LogOddsConfig")
@@ -110,43 +114,64 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("geometry", &LogOddsGrid::geometry)
       .def_property_readonly("config", &LogOddsGrid::config)
       .def_property_readonly_static("quantum", [](py::object) { return LogOddsGrid::kQuantum; })
-      .def_property_readonly("hit_increment",
-                             [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.hitUnits()); })
-      .def_property_readonly("miss_increment",
-                             [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.missUnits()); })
-      .def("log_odds", [](const LogOddsGrid& g) {
-        return gridArray<float>(g, [&g](std::size_t i) { return static_cast<float>(g.logOdds(i)); });
-      }, "(size_y, size_x) float32 log-odds.")
-      .def("probability", [](const LogOddsGrid& g) {
-        return gridArray<float>(g, [&g](std::size_t i) { return static_cast<float>(g.probability(i)); });
-      }, "(size_y, size_x) float32 P(occupied).")
-      .def("states", [](const LogOddsGrid& g) {
-        return gridArray<std::int8_t>(g, [&g](std::size_t i) { return static_cast<std::int8_t>(g.state(i)); });
-      }, "(size_y, size_x) int8: -1 unknown, 0 free, 1 occupied (by the thresholds).")
-      .def("set_log_odds", [](LogOddsGrid& g, py::array_t<double, py::array::c_style | py::array::forcecast> values) {
-        const GridGeometry& geo = g.geometry();
-        if (values.ndim() != 2 || values.shape(0) != geo.sizeY() || values.shape(1) != geo.sizeX()) {
-          throw std::invalid_argument("expected an array of shape (size_y, size_x)");
-        }
-        const double* v = values.data();
-        for (std::size_t i = 0; i < geo.cellCount(); ++i) g.setLogOdds(i, v[i]);
-      })
-      .def("add_hit", [](LogOddsGrid& g, int x, int y) {
-        checkIndex(g, x, y);
-        return LogOddsGrid::dequantize(g.addHit(g.geometry().index(x, y)));
-      })
-      .def("add_miss", [](LogOddsGrid& g, int x, int y) {
-        checkIndex(g, x, y);
-        return LogOddsGrid::dequantize(g.addMiss(g.geometry().index(x, y)));
-      })
-      .def("cell_log_odds", [](const LogOddsGrid& g, int x, int y) {
-        checkIndex(g, x, y);
-        return g.logOdds(g.geometry().index(x, y));
-      })
-      .def("cell_probability", [](const LogOddsGrid& g, int x, int y) {
-        checkIndex(g, x, y);
-        return g.probability(g.geometry().index(x, y));
-      })
+      .def_property_readonly(
+          "hit_increment",
+          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.hitUnits()); })
+      .def_property_readonly(
+          "miss_increment",
+          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.missUnits()); })
+      .def(
+          "log_odds",
+          [](const LogOddsGrid& g) {
+            return gridArray<float>(
+                g, [&g](std::size_t i) { return static_cast<float>(g.logOdds(i)); });
+          },
+          "(size_y, size_x) float32 log-odds.")
+      .def(
+          "probability",
+          [](const LogOddsGrid& g) {
+            return gridArray<float>(
+                g, [&g](std::size_t i) { return static_cast<float>(g.probability(i)); });
+          },
+          "(size_y, size_x) float32 P(occupied).")
+      .def(
+          "states",
+          [](const LogOddsGrid& g) {
+            return gridArray<std::int8_t>(
+                g, [&g](std::size_t i) { return static_cast<std::int8_t>(g.state(i)); });
+          },
+          "(size_y, size_x) int8: -1 unknown, 0 free, 1 occupied (by the thresholds).")
+      .def("set_log_odds",
+           [](LogOddsGrid& g,
+              py::array_t<double, py::array::c_style | py::array::forcecast> values) {
+             const GridGeometry& geo = g.geometry();
+             if (values.ndim() != 2 || values.shape(0) != geo.sizeY() ||
+                 values.shape(1) != geo.sizeX()) {
+               throw std::invalid_argument("expected an array of shape (size_y, size_x)");
+             }
+             const double* v = values.data();
+             for (std::size_t i = 0; i < geo.cellCount(); ++i) g.setLogOdds(i, v[i]);
+           })
+      .def("add_hit",
+           [](LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return LogOddsGrid::dequantize(g.addHit(g.geometry().index(x, y)));
+           })
+      .def("add_miss",
+           [](LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return LogOddsGrid::dequantize(g.addMiss(g.geometry().index(x, y)));
+           })
+      .def("cell_log_odds",
+           [](const LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return g.logOdds(g.geometry().index(x, y));
+           })
+      .def("cell_probability",
+           [](const LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return g.probability(g.geometry().index(x, y));
+           })
       .def("reset", &LogOddsGrid::reset)
       .def("shift", &LogOddsGrid::shift, py::arg("dx"), py::arg("dy"))
       .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds)
@@ -177,30 +202,34 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("cells_cleared", &IntegrationStats::cells_cleared)
       .def_readonly("cells_marked", &IntegrationStats::cells_marked)
       .def_readonly("cells_changed", &IntegrationStats::cells_changed)
-      .def_property_readonly("touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
-                             "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
-      .def_property_readonly("changed", [](const IntegrationStats& s) { return boundsToTuple(s.changed); })
+      .def_property_readonly(
+          "touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
+          "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
+      .def_property_readonly("changed",
+                             [](const IntegrationStats& s) { return boundsToTuple(s.changed); })
       .def("clear_mark_ratio", &IntegrationStats::clearMarkRatio);
 
   py::class_<ScanIntegrator>(m, "ScanIntegrator")
       .def(py::init<const ScanIntegratorConfig&>(), py::arg("config") = ScanIntegratorConfig{})
       .def_property_readonly("config", &ScanIntegrator::config)
-      .def("integrate",
-           [](ScanIntegrator& self, LogOddsGrid& grid,
-              py::array_t<float, py::array::c_style | py::array::forcecast> ranges, double angle_min,
-              double angle_increment, double range_min, double range_max,
-              std::tuple<double, double, double> pose) {
-             if (ranges.ndim() != 1) throw std::invalid_argument("ranges must be 1-D");
-             LaserScanView view{ranges.data(), static_cast<std::size_t>(ranges.shape(0)),
-                                angle_min, angle_increment, range_min, range_max};
-             const Pose2D p{std::get<0>(pose), std::get<1>(pose), std::get<2>(pose)};
-             py::gil_scoped_release release;
-             return self.integrate(grid, view, p);
-           },
-           py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
-           py::arg("range_min"), py::arg("range_max"), py::arg("sensor_pose"),
-           "Integrates one LaserScan (REP-117 semantics) taken at sensor_pose = (x, y, yaw) in the "
-           "grid frame. Raises ValueError for a malformed scan header.");
+      .def(
+          "integrate",
+          [](ScanIntegrator& self, LogOddsGrid& grid,
+             py::array_t<float, py::array::c_style | py::array::forcecast> ranges, double angle_min,
+             double angle_increment, double range_min, double range_max,
+             std::tuple<double, double, double> pose) {
+            if (ranges.ndim() != 1) throw std::invalid_argument("ranges must be 1-D");
+            LaserScanView view{ranges.data(), static_cast<std::size_t>(ranges.shape(0)),
+                               angle_min,     angle_increment,
+                               range_min,     range_max};
+            const Pose2D p{std::get<0>(pose), std::get<1>(pose), std::get<2>(pose)};
+            py::gil_scoped_release release;
+            return self.integrate(grid, view, p);
+          },
+          py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
+          py::arg("range_min"), py::arg("range_max"), py::arg("sensor_pose"),
+          "Integrates one LaserScan (REP-117 semantics) taken at sensor_pose = (x, y, yaw) in the "
+          "grid frame. Raises ValueError for a malformed scan header.");
 
   // ----------------------------------------------------------------- SE(2)
   py::class_<Pose2D>(m, "Pose2D")
@@ -216,19 +245,23 @@ PYBIND11_MODULE(_core, m) {
       });
   m.def("compose", &compose, "a ∘ b (parent<-mid ∘ mid<-child = parent<-child)");
   m.def("inverse", &inverse);
-  m.def("apply", [](const Pose2D& a, py::array_t<double, py::array::c_style | py::array::forcecast> points) {
-    if (points.ndim() != 2 || points.shape(1) != 2) throw std::invalid_argument("points must be (N, 2)");
-    const py::ssize_t n = points.shape(0);
-    py::array_t<double> out({n, py::ssize_t{2}});
-    const double* in = points.data();
-    double* o = out.mutable_data();
-    for (py::ssize_t i = 0; i < n; ++i) {
-      const Point2 q = apply(a, {in[2 * i], in[2 * i + 1]});
-      o[2 * i] = q.x;
-      o[2 * i + 1] = q.y;
-    }
-    return out;
-  }, "R p + t for each row of an (N, 2) array.");
+  m.def(
+      "apply",
+      [](const Pose2D& a, py::array_t<double, py::array::c_style | py::array::forcecast> points) {
+        if (points.ndim() != 2 || points.shape(1) != 2)
+          throw std::invalid_argument("points must be (N, 2)");
+        const py::ssize_t n = points.shape(0);
+        py::array_t<double> out({n, py::ssize_t{2}});
+        const double* in = points.data();
+        double* o = out.mutable_data();
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const Point2 q = apply(a, {in[2 * i], in[2 * i + 1]});
+          o[2 * i] = q.x;
+          o[2 * i + 1] = q.y;
+        }
+        return out;
+      },
+      "R p + t for each row of an (N, 2) array.");
   m.def("interpolate", &interpolate, py::arg("a"), py::arg("t_a"), py::arg("b"), py::arg("t_b"),
         py::arg("t"), "Linear in translation, shortest arc in yaw.");
   m.def("normalize_angle", &normalizeAngle);
@@ -239,10 +272,13 @@ PYBIND11_MODULE(_core, m) {
   m.attr("INSCRIBED_INFLATED_OBSTACLE") = cost::kInscribedInflatedObstacle;
   m.attr("LETHAL_OBSTACLE") = cost::kLethalObstacle;
   m.attr("NO_INFORMATION") = cost::kNoInformation;
-  m.def("occupancy_table", []() {
-    constexpr auto table = cost::occupancyTable();
-    py::array_t<std::int8_t> out(256);
-    std::copy(table.begin(), table.end(), out.mutable_data());
-    return out;
-  }, "cost (0..255) -> nav_msgs/OccupancyGrid value, costmap_2d's translation.");
+  m.def(
+      "occupancy_table",
+      []() {
+        constexpr auto table = cost::occupancyTable();
+        py::array_t<std::int8_t> out(256);
+        std::copy(table.begin(), table.end(), out.mutable_data());
+        return out;
+      },
+      "cost (0..255) -> nav_msgs/OccupancyGrid value, costmap_2d's translation.");
 }

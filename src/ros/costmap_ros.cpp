@@ -23,7 +23,7 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
   plugin_loader_ = std::make_unique<pluginlib::ClassLoader<Layer>>("downstream_perception",
-                                                                  "downstream_perception::Layer");
+                                                                   "downstream_perception::Layer");
   layered_costmap_ =
       std::make_unique<LayeredCostmap>(config_.global_frame, config_.track_unknown_space);
 
@@ -39,11 +39,12 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   publisher_ = std::make_unique<CostmapPublisher>(pnh_, "costmap", config_.global_frame);
   update_timer_ = nh_.createTimer(ros::Duration(1.0 / config_.update_frequency),
                                   &CostmapRos::updateTimerCallback, this);
-  ROS_INFO("costmap: %d x %d cells at %.3f m in '%s', origin (%.2f, %.2f), %zu layer(s), "
-           "update %.1f Hz, publish %.1f Hz",
-           size_x, size_y, config_.resolution, config_.global_frame.c_str(), config_.origin_x,
-           config_.origin_y, layered_costmap_->plugins().size(), config_.update_frequency,
-           config_.publish_frequency);
+  ROS_INFO(
+      "costmap: %d x %d cells at %.3f m in '%s', origin (%.2f, %.2f), %zu layer(s), "
+      "update %.1f Hz, publish %.1f Hz",
+      size_x, size_y, config_.resolution, config_.global_frame.c_str(), config_.origin_x,
+      config_.origin_y, layered_costmap_->plugins().size(), config_.update_frequency,
+      config_.publish_frequency);
 }
 
 CostmapRos::~CostmapRos() {
@@ -143,7 +144,8 @@ void CostmapRos::loadPlugins() {
       });
       ROS_INFO("costmap: loaded layer '%s' (%s)", name.c_str(), type.c_str());
     } catch (const pluginlib::PluginlibException& e) {
-      const std::string msg = "cannot load layer '" + name + "' of type '" + type + "': " + e.what();
+      const std::string msg =
+          "cannot load layer '" + name + "' of type '" + type + "': " + e.what();
       ROS_ERROR("costmap: %s", msg.c_str());
       config_errors_.push_back(msg);
     }
@@ -152,8 +154,8 @@ void CostmapRos::loadPlugins() {
 
 bool CostmapRos::robotPose(double* x, double* y, double* yaw) {
   try {
-    const auto t = tf_buffer_->lookupTransform(config_.global_frame, config_.robot_base_frame,
-                                               ros::Time(0));
+    const auto t =
+        tf_buffer_->lookupTransform(config_.global_frame, config_.robot_base_frame, ros::Time(0));
     // A chain of static transforms comes back with stamp 0: it is valid at every time.
     const double age = t.header.stamp.isZero() ? 0.0 : (ros::Time::now() - t.header.stamp).toSec();
     if (age > config_.transform_tolerance) {
@@ -196,7 +198,8 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
 
   const ros::Time now = ros::Time::now();
   if (config_.publish_frequency > 0.0 &&
-      (last_publish_.isZero() || (now - last_publish_).toSec() >= 1.0 / config_.publish_frequency)) {
+      (last_publish_.isZero() ||
+       (now - last_publish_).toSec() >= 1.0 / config_.publish_frequency)) {
     std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
     publisher_->publish(layered_costmap_->costmap(), now);
     last_publish_ = now;

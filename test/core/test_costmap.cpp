@@ -36,8 +36,8 @@ TEST(Costmap, ResetWindowAndShift) {
   m.shift(-1, 2);  // origin moves -1 cell in x, +2 in y
   EXPECT_DOUBLE_EQ(m.geometry().originX(), -1.0);
   EXPECT_DOUBLE_EQ(m.geometry().originY(), 2.0);
-  EXPECT_EQ(m.cost(1, 0), 20);   // old (0, 2)
-  EXPECT_EQ(m.cost(4, 1), 33);   // old (3, 3)
+  EXPECT_EQ(m.cost(1, 0), 20);                    // old (0, 2)
+  EXPECT_EQ(m.cost(4, 1), 33);                    // old (3, 3)
   EXPECT_EQ(m.cost(0, 0), cost::kNoInformation);  // newly exposed column
   EXPECT_EQ(m.cost(2, 3), cost::kNoInformation);  // newly exposed rows
 }

@@ -36,7 +36,7 @@ TEST(GridGeometry, BoundsAndNonFinite) {
   const GridGeometry g(10, 20, 0.5, 1.0, 2.0);
   CellIndex c;
   EXPECT_TRUE(g.worldToCell(1.0, 2.0, &c));
-  EXPECT_FALSE(g.worldToCell(6.0, 2.0, &c));   // x = 1 + 10 * 0.5 is the first cell outside
+  EXPECT_FALSE(g.worldToCell(6.0, 2.0, &c));  // x = 1 + 10 * 0.5 is the first cell outside
   EXPECT_TRUE(g.worldToCell(5.999, 11.999, &c));
   EXPECT_EQ(c.x, 9);
   EXPECT_EQ(c.y, 19);

@@ -43,7 +43,8 @@ TEST(WriteStateCosts, MatchesPerCellStateOnRandomGridsAndClampsTheWindow) {
   for (int y = 0; y < g.sizeY(); ++y) {
     for (int x = 0; x < g.sizeX(); ++x) {
       const CellState s = grid.state(g.index(x, y));
-      const std::uint8_t expected = s == CellState::kOccupied ? cost::kLethalObstacle : cost::kFreeSpace;
+      const std::uint8_t expected =
+          s == CellState::kOccupied ? cost::kLethalObstacle : cost::kFreeSpace;
       ASSERT_EQ(master.cost(x, y), expected) << x << "," << y;
     }
   }

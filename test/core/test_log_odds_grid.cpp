@@ -118,8 +118,10 @@ TEST(LogOdds, FixedPointErrorStaysWithinTheDocumentedBound) {
   for (int n = 1; n <= 5000; ++n) {
     const bool h = is_hit(rng);
     exact = std::clamp(exact + (h ? hit : miss), -8.0, 8.0);
-    if (h) g.addHit(0);
-    else g.addMiss(0);
+    if (h)
+      g.addHit(0);
+    else
+      g.addMiss(0);
     ASSERT_LE(std::abs(g.logOdds(0) - exact), (n + 1) * kHalfQ) << "after " << n;
   }
   // And a single set/get rounds by at most half a quantum.

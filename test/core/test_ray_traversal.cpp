@@ -34,8 +34,10 @@ bool segmentCrossesCell(double x0, double y0, double x1, double y1, int cx, int 
       continue;
     }
     const double t = q[k] / p[k];
-    if (p[k] < 0) t0 = std::max(t0, t);
-    else t1 = std::min(t1, t);
+    if (p[k] < 0)
+      t0 = std::max(t0, t);
+    else
+      t1 = std::min(t1, t);
   }
   return t1 - t0 > 0.0;
 }
@@ -43,7 +45,8 @@ bool segmentCrossesCell(double x0, double y0, double x1, double y1, int cx, int 
 
 TEST(Bresenham, LessonGoldenLine) {
   const auto cells = pairs(bresenhamLine(2, 2, 7, 5));
-  const std::vector<std::pair<int, int>> expected = {{2, 2}, {3, 3}, {4, 3}, {5, 4}, {6, 4}, {7, 5}};
+  const std::vector<std::pair<int, int>> expected = {{2, 2}, {3, 3}, {4, 3},
+                                                     {5, 4}, {6, 4}, {7, 5}};
   EXPECT_EQ(cells, expected);
 }
 
@@ -57,7 +60,8 @@ TEST(Bresenham, EndpointsIncludedAndConnected) {
     ASSERT_EQ(cells.front().y, y0);
     ASSERT_EQ(cells.back().x, x1);
     ASSERT_EQ(cells.back().y, y1);
-    ASSERT_EQ(cells.size(), static_cast<size_t>(std::max(std::abs(x1 - x0), std::abs(y1 - y0))) + 1);
+    ASSERT_EQ(cells.size(),
+              static_cast<size_t>(std::max(std::abs(x1 - x0), std::abs(y1 - y0))) + 1);
     for (size_t i = 1; i < cells.size(); ++i) {
       ASSERT_LE(std::abs(cells[i].x - cells[i - 1].x), 1);
       ASSERT_LE(std::abs(cells[i].y - cells[i - 1].y), 1);
@@ -75,7 +79,8 @@ TEST(TraverseRay, GoldenLineThroughCellCentresVisitsEveryCrossedCell) {
   EXPECT_EQ(cells, expected);
   // Every Bresenham cell except the corner-adjacent ones is on the exact path.
   for (const auto& c : bresenhamLine(2, 2, 7, 5)) {
-    const bool on_path = std::find(cells.begin(), cells.end(), std::make_pair(c.x, c.y)) != cells.end();
+    const bool on_path =
+        std::find(cells.begin(), cells.end(), std::make_pair(c.x, c.y)) != cells.end();
     EXPECT_TRUE(on_path) << c.x << "," << c.y;
   }
 }
@@ -103,11 +108,12 @@ TEST(TraverseRay, DiagonalHasNoGapsAndNoRepeats) {
     const double gx0 = (x0 + 2.5) / 0.05, gy0 = (y0 + 2.5) / 0.05;
     const double gx1 = (x1 + 2.5) / 0.05, gy1 = (y1 + 2.5) / 0.05;
     for (const auto& c : cells) {
-      EXPECT_TRUE(segmentCrossesCell(gx0, gy0, gx1, gy1, c.x, c.y) ||
-                  c == cells.front() || c == cells.back());
+      EXPECT_TRUE(segmentCrossesCell(gx0, gy0, gx1, gy1, c.x, c.y) || c == cells.front() ||
+                  c == cells.back());
     }
-    const int expected = std::abs(static_cast<int>(std::floor(gx1)) - static_cast<int>(std::floor(gx0))) +
-                         std::abs(static_cast<int>(std::floor(gy1)) - static_cast<int>(std::floor(gy0))) + 1;
+    const int expected =
+        std::abs(static_cast<int>(std::floor(gx1)) - static_cast<int>(std::floor(gx0))) +
+        std::abs(static_cast<int>(std::floor(gy1)) - static_cast<int>(std::floor(gy0))) + 1;
     EXPECT_EQ(static_cast<int>(cells.size()), expected);
   }
 }
@@ -159,11 +165,13 @@ TEST(TraverseRay, EndpointsOnEdgesAndCornersEndInTheEndCell) {
       const auto cells = rayCells(g, x0, y0, x1, y1);
       ASSERT_FALSE(cells.empty());
       ASSERT_EQ(cells.front(), g.worldToCellUnbounded(x0, y0));
-      ASSERT_EQ(cells.back(), g.worldToCellUnbounded(x1, y1)) << x0 << "," << y0 << " -> " << x1 << "," << y1;
+      ASSERT_EQ(cells.back(), g.worldToCellUnbounded(x1, y1))
+          << x0 << "," << y0 << " -> " << x1 << "," << y1;
       for (std::size_t i = 0; i < cells.size(); ++i) {
         ASSERT_TRUE(g.inBounds(cells[i].x, cells[i].y));
         if (i > 0) {
-          ASSERT_EQ(std::abs(cells[i].x - cells[i - 1].x) + std::abs(cells[i].y - cells[i - 1].y), 1);
+          ASSERT_EQ(std::abs(cells[i].x - cells[i - 1].x) + std::abs(cells[i].y - cells[i - 1].y),
+                    1);
         }
       }
     }

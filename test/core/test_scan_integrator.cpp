@@ -50,7 +50,7 @@ TEST(ScanIntegrator, OneBeamClearsThenMarks) {
   EXPECT_EQ(f.unitsAt(2.05, 0.0), f.grid.hitUnits());
   EXPECT_EQ(f.unitsAt(1.0, 0.0), f.grid.missUnits());
   EXPECT_EQ(f.unitsAt(0.0, 0.0), f.grid.missUnits());  // the sensor's own cell is crossed
-  EXPECT_EQ(f.unitsAt(2.25, 0.0), 0);                   // behind the hit: untouched
+  EXPECT_EQ(f.unitsAt(2.25, 0.0), 0);                  // behind the hit: untouched
   EXPECT_DOUBLE_EQ(stats.clearMarkRatio(), 20.0);
   EXPECT_EQ(stats.touched.min_x, 50);
   EXPECT_EQ(stats.touched.max_x, 70);
@@ -72,8 +72,8 @@ TEST(ScanIntegrator, Rep117SpecialValues) {
   EXPECT_EQ(stats.beams_invalid, 2u);
   EXPECT_EQ(stats.beams_no_return, 1u);
   EXPECT_EQ(stats.cells_marked, 0u);
-  EXPECT_EQ(f.unitsAt(1.0, 0.0), 0);    // NaN beam did nothing
-  EXPECT_EQ(f.unitsAt(0.0, 1.0), 0);    // -Inf beam did nothing
+  EXPECT_EQ(f.unitsAt(1.0, 0.0), 0);                     // NaN beam did nothing
+  EXPECT_EQ(f.unitsAt(0.0, 1.0), 0);                     // -Inf beam did nothing
   EXPECT_EQ(f.unitsAt(-4.45, 0.0), f.grid.missUnits());  // +Inf beam cleared out to 4.47 m
   EXPECT_EQ(f.unitsAt(-4.55, 0.0), 0);                   // and no further
   EXPECT_EQ(stats.cells_cleared, 46u);  // cells 50 down to 5 (x = -4.47 lies in cell 5)
@@ -157,7 +157,8 @@ TEST(ScanIntegrator, EachCellUpdatedOncePerScanAndHitsWin) {
   EXPECT_EQ(f.unitsAt(0.5, 0.0), f.grid.missUnits());
   // A grazing beam passes through the cell another beam of the same scan hits: the hit wins.
   Fixture g;
-  // Beam A hits (2.05, 0.05) exactly; beam B, to (3.0, 0.0), crosses that cell's row at y in [0, 0.1).
+  // Beam A hits (2.05, 0.05) exactly; beam B, to (3.0, 0.0), crosses that cell's row at y in [0,
+  // 0.1).
   const float ra = static_cast<float>(std::hypot(2.05, 0.05));
   const double aa = std::atan2(0.05, 2.05);
   std::vector<float> two = {3.0f, ra};

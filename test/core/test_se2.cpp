@@ -7,7 +7,9 @@
 using namespace downstream_perception;  // NOLINT
 
 namespace {
-double deg(double d) { return d * M_PI / 180.0; }
+double deg(double d) {
+  return d * M_PI / 180.0;
+}
 }  // namespace
 
 TEST(SE2, LessonCompositionMapOdomBase) {

@@ -42,7 +42,7 @@ def test_ray_cells_match_a_numpy_supercover_reference() -> None:
         t = np.linspace(0.0, 1.0, 20001)
         px = np.floor((x0 + t * (x1 - x0) + 3.0) / 0.1).astype(int)
         py = np.floor((y0 + t * (y1 - y0) + 3.0) / 0.1).astype(int)
-        sampled = {(int(a), int(b)) for a, b in zip(px, py)}
+        sampled = {(int(a), int(b)) for a, b in zip(px, py, strict=True)}
         walked = {(int(a), int(b)) for a, b in cells}
         assert len(walked) == len(cells)  # no cell twice
         # Dense sampling can miss a cell clipped at a corner by less than a sample step, never
@@ -152,7 +152,9 @@ def test_se2_golden_numbers() -> None:
     assert wall[0] == pytest.approx([8.0186, 4.0921], abs=1e-4)
     goal = dp.apply(dp.inverse(map_base), np.array([[8.0, 4.0]]))
     assert goal[0] == pytest.approx([3.9266, -0.0586], abs=1e-4)
-    p = dp.interpolate(dp.Pose2D(4.90, 1.50, deg(38)), 1.00, dp.Pose2D(5.06, 1.62, deg(44)), 1.10, 1.06)
+    p = dp.interpolate(
+        dp.Pose2D(4.90, 1.50, deg(38)), 1.00, dp.Pose2D(5.06, 1.62, deg(44)), 1.10, 1.06
+    )
     assert p.as_tuple() == pytest.approx((4.996, 1.572, deg(41.6)), abs=1e-9)
     q = dp.interpolate(dp.Pose2D(0, 0, deg(358)), 0.0, dp.Pose2D(0, 0, deg(4)), 1.0, 0.6)
     assert q.yaw == pytest.approx(deg(1.6), abs=1e-9)

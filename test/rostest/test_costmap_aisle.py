@@ -99,8 +99,11 @@ class CostmapAisleTest(unittest.TestCase):
 
     def test_ground_truth_obstacles_found(self) -> None:
         truth = warehouse_aisle().occupied_cells(
-            self.info.origin.position.x, self.info.origin.position.y, self.info.resolution,
-            self.info.width, self.info.height,
+            self.info.origin.position.x,
+            self.info.origin.position.y,
+            self.info.resolution,
+            self.info.width,
+            self.info.height,
         )
         seen = truth & (self.grid != -1) & (self.wx > 2.0) & (self.wx < 17.0)
         lethal = self.grid == 100

@@ -35,7 +35,9 @@ class BadInputTest(unittest.TestCase):
         rospy.init_node("test_costmap_bad_input")
         cls.grids: dict[str, OccupancyGrid] = {}
         cls.status: dict[str, tuple[int, str, dict[str, str]]] = {}
-        rospy.Subscriber("/costmap/costmap", OccupancyGrid, lambda m: cls.grids.__setitem__("ok", m))
+        rospy.Subscriber(
+            "/costmap/costmap", OccupancyGrid, lambda m: cls.grids.__setitem__("ok", m)
+        )
         rospy.Subscriber(
             "/costmap_absurd/costmap", OccupancyGrid, lambda m: cls.grids.__setitem__("absurd", m)
         )
@@ -49,7 +51,10 @@ class BadInputTest(unittest.TestCase):
         cls.static_tf = tf2_ros.StaticTransformBroadcaster()
         now = rospy.Time.now()
         cls.static_tf.sendTransform(
-            [transform("map", "base_link", 0.0, 0.0, now), transform("map", "laser", 0.05, 0.05, now)]
+            [
+                transform("map", "base_link", 0.0, 0.0, now),
+                transform("map", "laser", 0.05, 0.05, now),
+            ]
         )
         cls.tf = tf2_ros.TransformBroadcaster()
         deadline = time.time() + 20.0
@@ -57,16 +62,20 @@ class BadInputTest(unittest.TestCase):
             time.sleep(0.1)
 
     # ------------------------------------------------------------------ helpers
-    def scan(self, ranges: list[float], frame: str = "laser", stamp: rospy.Time | None = None,
-             angle_increment: float = 2 * math.pi / 8, angle_max: float | None = None) -> LaserScan:
+    def scan(
+        self,
+        ranges: list[float],
+        frame: str = "laser",
+        stamp: rospy.Time | None = None,
+        angle_increment: float = 2 * math.pi / 8,
+        angle_max: float | None = None,
+    ) -> LaserScan:
         msg = LaserScan()
         msg.header.frame_id = frame
         msg.header.stamp = rospy.Time.now() if stamp is None else stamp
         msg.angle_min = 0.0
         msg.angle_increment = angle_increment
-        msg.angle_max = (
-            angle_max if angle_max is not None else angle_increment * (len(ranges) - 1)
-        )
+        msg.angle_max = angle_max if angle_max is not None else angle_increment * (len(ranges) - 1)
         msg.range_min = 0.05
         msg.range_max = 10.0
         msg.ranges = ranges
@@ -74,7 +83,9 @@ class BadInputTest(unittest.TestCase):
 
     def publish(self, msg: LaserScan, times: int = 1) -> None:
         for _ in range(times):
-            msg.header.stamp = rospy.Time.now() if msg.header.stamp != rospy.Time(0) else msg.header.stamp
+            msg.header.stamp = (
+                rospy.Time.now() if msg.header.stamp != rospy.Time(0) else msg.header.stamp
+            )
             self.pub.publish(msg)
             time.sleep(0.05)
 
@@ -99,14 +110,18 @@ class BadInputTest(unittest.TestCase):
 
     def rejected(self, reason_prefix: str) -> int:
         values = self.layer()[2]
-        return sum(int(v) for k, v in values.items() if k.startswith(f"scan: rejected ({reason_prefix}"))
+        return sum(
+            int(v) for k, v in values.items() if k.startswith(f"scan: rejected ({reason_prefix}")
+        )
 
     # ------------------------------------------------------------------ tests
     def test_1_good_scan_marks_then_garbage_is_rejected_and_map_survives(self) -> None:
         # One beam along +x hits at 1.0 m -> the cell containing (1.05, 0.05) becomes lethal.
         good = [1.0] + [math.inf] * 7
         self.publish(self.scan(good), times=5)
-        self.assertTrue(self.wait_for(lambda: "ok" in self.grids and self.cell("ok", 1.05, 0.05) == 100))
+        self.assertTrue(
+            self.wait_for(lambda: "ok" in self.grids and self.cell("ok", 1.05, 0.05) == 100)
+        )
 
         # All-NaN and all -Inf scans: ignored beams, no marks, no crash.
         self.publish(self.scan([math.nan] * 8), times=3)
@@ -142,11 +157,15 @@ class BadInputTest(unittest.TestCase):
         self.assertEqual(self.cell("ok", -1.5, -0.8), -1, "unseen cells stay unknown")
 
     def test_2_absurd_parameters_are_reported_and_defaults_used(self) -> None:
-        self.assertTrue(self.wait_for(lambda: "absurd" in self.grids), "absurd costmap never published")
+        self.assertTrue(
+            self.wait_for(lambda: "absurd" in self.grids), "absurd costmap never published"
+        )
         info = self.grids["absurd"].info
         self.assertAlmostEqual(info.resolution, 0.05, places=6)  # default, not -0.1
         self.assertEqual((info.width, info.height), (200, 200))  # 10 m default at 0.05 m
-        self.assertTrue(self.wait_for(lambda: any(k.endswith("costmap_absurd: costmap") for k in self.status)))
+        self.assertTrue(
+            self.wait_for(lambda: any(k.endswith("costmap_absurd: costmap") for k in self.status))
+        )
         key = next(k for k in self.status if k.endswith("costmap_absurd: costmap"))
         level, message, values = self.status[key]
         self.assertEqual(level, 2)

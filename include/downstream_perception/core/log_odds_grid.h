@@ -18,8 +18,8 @@
 namespace downstream_perception {
 
 struct LogOddsConfig {
-  double p_hit = 0.7;   ///< inverse sensor model: P(occupied) given a return in the cell
-  double p_miss = 0.4;  ///< P(occupied) given a beam passing through the cell
+  double p_hit = 0.7;       ///< inverse sensor model: P(occupied) given a return in the cell
+  double p_miss = 0.4;      ///< P(occupied) given a beam passing through the cell
   double clamp_min = -8.0;  ///< lower log-odds clamp (keeps free cells re-learnable)
   double clamp_max = 8.0;   ///< upper log-odds clamp (keeps walls un-learnable in bounded time)
   double occupied_threshold = 2.0;  ///< log-odds above this -> occupied (p > 0.881)

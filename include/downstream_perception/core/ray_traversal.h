@@ -77,7 +77,7 @@ struct RayWalk {
   int sy = 1;
   int steps_x = 0;  ///< x steps from the start cell to the end cell
   int steps_y = 0;
-  std::int64_t err = 0;  ///< <= 0: the next edge crossed is vertical (step in x)
+  std::int64_t err = 0;         ///< <= 0: the next edge crossed is vertical (step in x)
   std::int64_t err_step_x = 0;  ///< added to err on an x step
   std::int64_t err_step_y = 0;  ///< subtracted from err on a y step
 

@@ -39,9 +39,9 @@ struct BeamUpdate {
   double start_y = 0.0;
   double end_x = 0.0;  ///< where clearing ends (world, m); the hit point when mark is true
   double end_y = 0.0;
-  bool clear = false;            ///< walk the cells from start to end adding l_miss
-  bool clear_end_cell = false;   ///< include the cell containing the end point in the clearing
-  bool mark = false;             ///< add l_hit to the cell containing (hit_x, hit_y)
+  bool clear = false;           ///< walk the cells from start to end adding l_miss
+  bool clear_end_cell = false;  ///< include the cell containing the end point in the clearing
+  bool mark = false;            ///< add l_hit to the cell containing (hit_x, hit_y)
   double hit_x = 0.0;
   double hit_y = 0.0;
 };
@@ -77,11 +77,11 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
 struct ScanIntegratorConfig {
   bool marking = true;
   bool clearing = true;
-  double obstacle_min_range = 0.0;   ///< m: returns nearer than this do not mark
-  double obstacle_max_range = 2.5;   ///< m: returns farther than this do not mark
-  double raytrace_min_range = 0.0;   ///< m: clearing starts this far from the sensor
-  double raytrace_max_range = 3.0;   ///< m: clearing stops this far from the sensor
-  bool inf_is_valid = true;          ///< +Inf means "no return": clear, do not mark
+  double obstacle_min_range = 0.0;      ///< m: returns nearer than this do not mark
+  double obstacle_max_range = 2.5;      ///< m: returns farther than this do not mark
+  double raytrace_min_range = 0.0;      ///< m: clearing starts this far from the sensor
+  double raytrace_max_range = 3.0;      ///< m: clearing stops this far from the sensor
+  bool inf_is_valid = true;             ///< +Inf means "no return": clear, do not mark
   bool range_max_is_no_return = false;  ///< treat r == range_max as +Inf
 
   std::string validate() const;

@@ -31,8 +31,8 @@ struct LaserScanSourceConfig {
 /// A scan that passed the checks, with the sensor pose in the layer's global frame at its stamp.
 struct AcceptedScan {
   sensor_msgs::LaserScanConstPtr msg;
-  LaserScanView view;   ///< angles already mirrored for an upside-down sensor
-  Pose2D sensor_pose;   ///< in the global frame, at msg->header.stamp
+  LaserScanView view;  ///< angles already mirrored for an upside-down sensor
+  Pose2D sensor_pose;  ///< in the global frame, at msg->header.stamp
 };
 
 class LaserScanSource {

@@ -20,8 +20,8 @@ class LogOddsObstacleLayer : public Layer {
   LogOddsObstacleLayer() = default;
   ~LogOddsObstacleLayer() override;
 
-  void updateBounds(double robot_x, double robot_y, double robot_yaw, double* min_x,
-                    double* min_y, double* max_x, double* max_y) override;
+  void updateBounds(double robot_x, double robot_y, double robot_yaw, double* min_x, double* min_y,
+                    double* max_x, double* max_y) override;
   void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
   void matchSize() override;
   void reset() override;

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# ruff (Python) and clang-format (C++) checks. ruff comes from PyPI into a venv inside the ignored
+# workspace folder, pinned so results do not change under us.
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
+venv="$WS/tools-venv"
+if [[ ! -x "$venv/bin/ruff" ]]; then
+  /usr/bin/python3 -m venv "$venv"
+  "$venv/bin/pip" install -q "ruff==0.8.6"
+fi
+cd "$REPO"
+"$venv/bin/ruff" check src scripts test tools
+"$venv/bin/ruff" format --check src scripts test tools
+clang-format --dry-run --Werror $(git ls-files '*.cpp' '*.h')
+echo "lint: ok"
