@@ -45,6 +45,7 @@ class CostmapRos {
   void updateTimerCallback(const ros::TimerEvent& event);
   bool robotPose(double* x, double* y, double* yaw);
   void diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void publishFootprint();
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
@@ -57,6 +58,7 @@ class CostmapRos {
   std::unique_ptr<pluginlib::ClassLoader<Layer>> plugin_loader_;
   std::unique_ptr<LayeredCostmap> layered_costmap_;
   std::unique_ptr<CostmapPublisher> publisher_;
+  ros::Publisher footprint_publisher_;
   diagnostic_updater::Updater diagnostics_;
 
   ros::Timer update_timer_;

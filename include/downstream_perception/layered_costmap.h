@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "downstream_perception/core/costmap.h"
+#include "downstream_perception/core/footprint.h"
 #include "downstream_perception/layer.h"
 
 namespace downstream_perception {
@@ -35,12 +36,21 @@ class LayeredCostmap {
   /// AND over the enabled layers.
   bool isCurrent() const;
 
+  /// Sets the (padded) footprint, computes its radii and tells every layer.
+  void setFootprint(const Footprint& footprint);
+  const Footprint& footprint() const { return footprint_; }
+  double inscribedRadius() const { return inscribed_radius_; }          ///< m
+  double circumscribedRadius() const { return circumscribed_radius_; }  ///< m
+
  private:
   std::string global_frame_;
   bool track_unknown_space_;
   Costmap master_;
   std::vector<std::shared_ptr<Layer>> plugins_;
   std::recursive_mutex mutex_;
+  Footprint footprint_;
+  double inscribed_radius_ = 0.0;
+  double circumscribed_radius_ = 0.0;
 };
 
 }  // namespace downstream_perception

@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "downstream_perception/core/inflation.h"
 #include "downstream_perception/core/log_odds_costs.h"
 #include "downstream_perception/core/scan_integrator.h"
 
@@ -123,6 +124,81 @@ void runIntegration(int size, double room_half, int beams, int iters) {
       static_cast<double>(changed) / iters, cells_per_scan / (median * 1e-3) / 1e6);
 }
 
+// One whole costmap update as our costmap runs it on the anchor scenario (static map,
+// track_unknown_space false, footprint inscribed radius 0.25 m): integrate the scan, reset the
+// master window (cells whose obstacle state changed, grown by the inflation radius), write the
+// obstacle states, inflate. Reports the inflation step and the whole update.
+void runInflation(int size, double room_half, int beams, double radius, double csf, int iters) {
+  const GridGeometry geometry(size, size, 0.05, -size * 0.025, -size * 0.025);
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 30.0;
+  config.raytrace_max_range = 30.0;
+  ScanIntegrator integrator(config);
+  InflationConfig ic;
+  ic.inflation_radius = radius;
+  ic.cost_scaling_factor = csf;
+  ic.inscribed_radius = 0.25;
+  Inflator inflator(ic, geometry.resolution());
+  std::mt19937 rng(1);
+  std::vector<std::vector<float>> scans;
+  for (int i = 0; i < 16; ++i) scans.push_back(roomScan(beams, room_half, 0.01, rng));
+  const Pose2D pose{0.01, 0.02, 0.0};
+  LogOddsGrid grid(geometry);
+  Costmap master(geometry, cost::kFreeSpace);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(size - 1, size - 1);
+  // Converge the log-odds grid first (a robot that has been looking at the room for 2 s).
+  for (int i = 0; i < 20; ++i) {
+    const auto& r = scans[i % scans.size()];
+    integrator.integrate(grid, {r.data(), r.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0}, pose);
+  }
+  writeStateCosts(grid, all, true, cost::kFreeSpace, &master);
+  auto t_first = std::chrono::steady_clock::now();
+  inflator.update(&master, all);
+  const double first_ms = msSince(t_first);
+
+  std::vector<double> inflate_ms, total_ms;
+  std::size_t lethal_changed = 0, recomputed = 0;
+  for (int i = 0; i < iters; ++i) {
+    const auto& r = scans[i % scans.size()];
+    const auto t0 = std::chrono::steady_clock::now();
+    const IntegrationStats s = integrator.integrate(
+        grid, {r.data(), r.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0}, pose);
+    CellBounds window = s.changed;
+    if (!window.empty()) {
+      window.min_x -= inflator.radiusCells();
+      window.min_y -= inflator.radiusCells();
+      window.max_x += inflator.radiusCells();
+      window.max_y += inflator.radiusCells();
+      master.resetWindow(window);
+      writeStateCosts(grid, window, true, cost::kFreeSpace, &master);
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    const InflationStats st = inflator.update(&master, window);
+    inflate_ms.push_back(msSince(t1));
+    total_ms.push_back(msSince(t0));
+    lethal_changed += st.lethal_changed;
+    recomputed += st.cells_recomputed;
+  }
+  std::size_t lethal = 0, inscribed = 0, nonzero = 0;
+  for (const std::uint8_t c : master.cells()) {
+    lethal += c == cost::kLethalObstacle;
+    inscribed += c == cost::kInscribedInflatedObstacle;
+    nonzero += c != cost::kFreeSpace;
+  }
+  std::printf(
+      "{\"bench\": \"inflation\", \"map\": %d, \"room_half_m\": %.3f, \"beams\": %d, "
+      "\"radius_m\": %.2f, \"cost_scaling_factor\": %.1f, \"iters\": %d, "
+      "\"inflation_median_ms\": %.4f, \"inflation_p90_ms\": %.4f, \"update_median_ms\": %.4f, "
+      "\"first_full_inflation_ms\": %.4f, \"lethal_changed_per_update\": %.1f, "
+      "\"cells_recomputed_per_update\": %.0f, \"lethal\": %zu, \"inscribed\": %zu, "
+      "\"nonzero\": %zu}\n",
+      size, room_half, beams, radius, csf, iters, medianOf(inflate_ms), p90Of(inflate_ms),
+      medianOf(total_ms), first_ms, static_cast<double>(lethal_changed) / iters,
+      static_cast<double>(recomputed) / iters, lethal, inscribed, nonzero);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -133,6 +209,13 @@ int main(int argc, char** argv) {
     if (only_size != 0 && size != only_size) continue;
     const double room_half = size == 200 ? 4.475 : 22.475;
     for (int beams : {360, 1080, 3600}) runIntegration(size, room_half, beams, iters);
+  }
+  // The costmap_2d anchor scenarios (radius m, cost_scaling_factor).
+  for (int size : {200, 1000}) {
+    if (only_size != 0 && size != only_size) continue;
+    const double room_half = size == 200 ? 4.475 : 22.475;
+    for (double radius : {0.55, 1.0}) runInflation(size, room_half, 360, radius, 10.0, iters);
+    if (size == 1000) runInflation(size, room_half, 3600, 2.5, 3.0, iters);
   }
   return 0;
 }

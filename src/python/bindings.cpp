@@ -6,7 +6,9 @@
 #include <stdexcept>
 
 #include "downstream_perception/core/cost_values.h"
+#include "downstream_perception/core/footprint.h"
 #include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/inflation.h"
 #include "downstream_perception/core/log_odds_grid.h"
 #include "downstream_perception/core/ray_traversal.h"
 #include "downstream_perception/core/scan_integrator.h"
@@ -281,4 +283,45 @@ PYBIND11_MODULE(_core, m) {
         return out;
       },
       "cost (0..255) -> nav_msgs/OccupancyGrid value, costmap_2d's translation.");
+
+  // ----------------------------------------------------------------- inflation
+  py::class_<InflationConfig>(m, "InflationConfig")
+      .def(py::init<>())
+      .def_readwrite("inflation_radius", &InflationConfig::inflation_radius, "m")
+      .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor, "1/m")
+      .def_readwrite("inscribed_radius", &InflationConfig::inscribed_radius, "m")
+      .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown)
+      .def("validate", &InflationConfig::validate);
+  m.def("inflation_cost", &inflationCost, py::arg("distance_m"), py::arg("config"),
+        "costmap_2d's cost for a cell at distance_m from the nearest lethal cell.");
+  m.def(
+      "inflate",
+      [](py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast> costs,
+         double resolution, const InflationConfig& config) {
+        if (costs.ndim() != 2) throw std::invalid_argument("costs must be a 2-D [y, x] array");
+        const int h = static_cast<int>(costs.shape(0));
+        const int w = static_cast<int>(costs.shape(1));
+        Costmap master(GridGeometry(w, h, resolution, 0.0, 0.0), cost::kFreeSpace);
+        std::copy(costs.data(), costs.data() + costs.size(), master.data());
+        Inflator inflator(config, resolution);
+        CellBounds all;
+        all.expand(0, 0);
+        all.expand(w - 1, h - 1);
+        inflator.update(&master, all);
+        py::array_t<std::uint8_t> out({h, w});
+        std::copy(master.cells().begin(), master.cells().end(), out.mutable_data());
+        return out;
+      },
+      py::arg("costs"), py::arg("resolution"), py::arg("config"),
+      "Inflates a whole [y, x] uint8 cost grid (254 = lethal) and returns the merged grid.");
+  m.def(
+      "footprint_radii",
+      [](const std::vector<std::pair<double, double>>& points) {
+        Footprint polygon;
+        for (const auto& [x, y] : points) polygon.push_back({x, y});
+        const std::string why = validateFootprint(polygon);
+        if (!why.empty()) throw std::invalid_argument(why);
+        return std::make_pair(inscribedRadius(polygon), circumscribedRadius(polygon));
+      },
+      py::arg("points"), "(inscribed, circumscribed) radius of a footprint polygon, m.");
 }

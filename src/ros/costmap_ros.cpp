@@ -1,5 +1,9 @@
 #include "downstream_perception/costmap_ros.h"
 
+#include <geometry_msgs/PolygonStamped.h>
+
+#include "downstream_perception/footprint_params.h"
+
 #include <tf2/utils.h>
 
 #include <chrono>
@@ -32,11 +36,14 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   layered_costmap_->resizeMap(
       GridGeometry(size_x, size_y, config_.resolution, config_.origin_x, config_.origin_y));
 
+  layered_costmap_->setFootprint(readFootprint(pnh_, &config_errors_));
+
   diagnostics_.setHardwareID("costmap " + config_.global_frame);
   diagnostics_.add("costmap", this, &CostmapRos::diagnoseCostmap);
   loadPlugins();
 
   publisher_ = std::make_unique<CostmapPublisher>(pnh_, "costmap", config_.global_frame);
+  publishFootprint();
   update_timer_ = nh_.createTimer(ros::Duration(1.0 / config_.update_frequency),
                                   &CostmapRos::updateTimerCallback, this);
   ROS_INFO(
@@ -51,6 +58,21 @@ CostmapRos::~CostmapRos() {
   update_timer_.stop();
   // Layers hold subscriptions that call back into them: drop them before the loader goes.
   layered_costmap_.reset();
+}
+
+void CostmapRos::publishFootprint() {
+  // Latched, in the robot frame: rviz draws it wherever the robot is.
+  footprint_publisher_ = pnh_.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
+  geometry_msgs::PolygonStamped msg;
+  msg.header.frame_id = config_.robot_base_frame;
+  msg.header.stamp = ros::Time::now();
+  for (const FootprintPoint& p : layered_costmap_->footprint()) {
+    geometry_msgs::Point32 q;
+    q.x = static_cast<float>(p.x);
+    q.y = static_cast<float>(p.y);
+    msg.polygon.points.push_back(q);
+  }
+  footprint_publisher_.publish(msg);
 }
 
 void CostmapRos::readConfig() {
@@ -231,6 +253,8 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("robot pose failures", robot_pose_failures_);
   if (!last_pose_error_.empty()) status.add("last robot pose error", last_pose_error_);
   status.add("config errors", config_errors_.size());
+  status.add("footprint inscribed radius (m)", layered_costmap_->inscribedRadius());
+  status.add("footprint circumscribed radius (m)", layered_costmap_->circumscribedRadius());
 }
 
 }  // namespace downstream_perception

@@ -48,4 +48,11 @@ bool LayeredCostmap::isCurrent() const {
   return true;
 }
 
+void LayeredCostmap::setFootprint(const Footprint& footprint) {
+  footprint_ = footprint;
+  inscribed_radius_ = downstream_perception::inscribedRadius(footprint);
+  circumscribed_radius_ = downstream_perception::circumscribedRadius(footprint);
+  for (const auto& plugin : plugins_) plugin->onFootprintChanged();
+}
+
 }  // namespace downstream_perception

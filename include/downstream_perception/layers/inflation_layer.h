@@ -1,0 +1,39 @@
+// downstream_perception/InflationLayer: costmap_2d's inflation costs from exact distances, updated
+// only where the set of lethal cells changed (see core/inflation.h). Must be the last layer.
+#pragma once
+
+#include <mutex>
+
+#include "downstream_perception/core/inflation.h"
+#include "downstream_perception/layer.h"
+#include "downstream_perception/running_stats.h"
+
+namespace downstream_perception {
+
+class InflationLayer : public Layer {
+ public:
+  void updateBounds(double robot_x, double robot_y, double robot_yaw, double* min_x, double* min_y,
+                    double* max_x, double* max_y) override;
+  void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
+  void matchSize() override;
+  void reset() override;
+  void onFootprintChanged() override;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+
+ protected:
+  void onInitialize() override;
+
+ private:
+  void applyConfig();
+
+  std::mutex mutex_;
+  InflationConfig config_;  ///< inscribed_radius comes from the footprint
+  std::unique_ptr<Inflator> inflator_;
+  std::vector<std::string> config_errors_;
+  bool need_full_window_ = true;  ///< after (re)configuration: update the whole map once
+  InflationStats last_;
+  std::size_t updates_ = 0;
+  RunningStats update_ms_;
+};
+
+}  // namespace downstream_perception

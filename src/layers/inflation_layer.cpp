@@ -1,0 +1,122 @@
+#include "downstream_perception/layers/inflation_layer.h"
+
+#include <pluginlib/class_list_macros.hpp>
+
+#include <chrono>
+#include <limits>
+
+#include "downstream_perception/layered_costmap.h"
+
+namespace downstream_perception {
+
+void InflationLayer::onInitialize() {
+  nh_.param("enabled", enabled_, true);
+  const InflationConfig defaults;
+  nh_.param("inflation_radius", config_.inflation_radius, defaults.inflation_radius);
+  nh_.param("cost_scaling_factor", config_.cost_scaling_factor, defaults.cost_scaling_factor);
+  nh_.param("inflate_unknown", config_.inflate_unknown, defaults.inflate_unknown);
+  applyConfig();
+}
+
+void InflationLayer::applyConfig() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  config_.inscribed_radius = layered_costmap_->inscribedRadius();
+  std::string why = config_.validate();
+  if (why.empty() && config_.inflation_radius < config_.inscribed_radius) {
+    // Allowed (costmap_2d accepts it) but the robot would touch walls the planner thinks clear.
+    ROS_WARN(
+        "layer '%s': inflation_radius %.3f m is smaller than the footprint's inscribed "
+        "radius %.3f m",
+        name_.c_str(), config_.inflation_radius, config_.inscribed_radius);
+  }
+  if (!why.empty()) {
+    const std::string msg = "parameters invalid (" + why + "); using the defaults";
+    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
+    config_errors_.push_back(msg);
+    const double inscribed = config_.inscribed_radius;
+    config_ = InflationConfig{};
+    config_.inscribed_radius = inscribed;
+  }
+  const double resolution = layered_costmap_->costmap().geometry().resolution();
+  inflator_ = std::make_unique<Inflator>(config_, resolution > 0.0 ? resolution : 0.05);
+  need_full_window_ = true;
+  ROS_INFO(
+      "layer '%s': inflation radius %.3f m (%d cells), cost_scaling_factor %.2f 1/m, "
+      "inscribed radius %.3f m",
+      name_.c_str(), config_.inflation_radius, inflator_->radiusCells(),
+      config_.cost_scaling_factor, config_.inscribed_radius);
+}
+
+void InflationLayer::updateBounds(double, double, double, double* min_x, double* min_y,
+                                  double* max_x, double* max_y) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (need_full_window_) {
+    const GridGeometry& g = layered_costmap_->costmap().geometry();
+    *min_x = std::min(*min_x, g.originX());
+    *min_y = std::min(*min_y, g.originY());
+    *max_x = std::max(*max_x, g.originX() + (g.sizeX() - 0.5) * g.resolution());
+    *max_y = std::max(*max_y, g.originY() + (g.sizeY() - 0.5) * g.resolution());
+    need_full_window_ = false;
+    return;
+  }
+  if (*min_x > *max_x) return;  // nothing changed upstream: nothing to re-inflate
+  // A lethal cell that appeared or vanished changes costs up to the radius around it.
+  const double r = config_.inflation_radius;
+  *min_x -= r;
+  *min_y -= r;
+  *max_x += r;
+  *max_y += r;
+}
+
+void InflationLayer::updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (min_i >= max_i || min_j >= max_j) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  CellBounds window;
+  window.expand(min_i, min_j);
+  window.expand(max_i - 1, max_j - 1);
+  last_ = inflator_->update(&master, window);
+  update_ms_.add(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  ++updates_;
+}
+
+void InflationLayer::matchSize() {
+  // The Inflator follows the master's geometry by itself; a new resolution needs a new table.
+  applyConfig();
+}
+
+void InflationLayer::reset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  inflator_->reset();
+  need_full_window_ = true;
+}
+
+void InflationLayer::onFootprintChanged() {
+  if (inflator_) applyConfig();
+}
+
+void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!config_errors_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "inflating");
+  }
+  status.add("inflation radius (m)", config_.inflation_radius);
+  status.add("inflation radius (cells)", inflator_->radiusCells());
+  status.add("cost scaling factor (1/m)", config_.cost_scaling_factor);
+  status.add("inscribed radius (m)", config_.inscribed_radius);
+  status.add("inflate unknown", config_.inflate_unknown);
+  status.add("updates", updates_);
+  status.add("update time mean (ms)", update_ms_.mean());
+  status.add("update time max (ms)", update_ms_.max);
+  status.add("last update: lethal cells changed", last_.lethal_changed);
+  status.add("last update: cells re-inflated", last_.cells_recomputed);
+  status.add("last update: cells merged", last_.cells_merged);
+  status.add("config errors", config_errors_.size());
+}
+
+}  // namespace downstream_perception
+
+PLUGINLIB_EXPORT_CLASS(downstream_perception::InflationLayer, downstream_perception::Layer)
