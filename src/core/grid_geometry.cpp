@@ -51,6 +51,15 @@ bool GridGeometry::worldToCell(double wx, double wy, CellIndex* cell) const {
   return true;
 }
 
+void GridGeometry::expandWorldBox(const CellBounds& cells, double* min_x, double* min_y,
+                                  double* max_x, double* max_y) const {
+  if (cells.empty()) return;
+  *min_x = std::min(*min_x, origin_x_ + cells.min_x * resolution_);
+  *min_y = std::min(*min_y, origin_y_ + cells.min_y * resolution_);
+  *max_x = std::max(*max_x, origin_x_ + (cells.max_x + 0.5) * resolution_);
+  *max_y = std::max(*max_y, origin_y_ + (cells.max_y + 0.5) * resolution_);
+}
+
 CellBounds GridGeometry::worldBoxToCells(double min_x, double min_y, double max_x,
                                          double max_y) const {
   CellBounds b;

@@ -176,6 +176,7 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
   const std::uint8_t* m = master->data();
   const int size_x = g.sizeX();
   const int tiles_x = (g.sizeX() >> kTileShift) + 1;
+  const CellBounds w = master->clamp(window);
 
   if (full_recompute_) {
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
@@ -190,7 +191,6 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
     full_recompute_ = false;
   } else {
     // Where did the set of lethal cells change?
-    const CellBounds w = master->clamp(window);
     CellBounds dirty_tile_box;
     std::size_t dirty_tile_count = 0;
     for (int y = w.min_y; !w.empty() && y <= w.max_y; ++y) {
@@ -245,7 +245,6 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
   }
 
   // Merge into the master over the window (costmap_2d's InflationLayer rule).
-  const CellBounds w = master->clamp(window);
   if (w.empty()) return stats;
   std::uint8_t* out = master->data();
   const std::uint8_t unknown_threshold =

@@ -84,6 +84,11 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
   const int miss = grid.missUnits();
   const std::ptrdiff_t size_x = geometry.sizeX();
   std::size_t walked = 0;
+  // A cell takes a miss unless it is flagged (hit or cleared in this scan) or already saturated
+  // free: one combined, almost always true test.
+  const auto skipsMiss = [saturated_free_raw](std::int16_t raw) {
+    return static_cast<bool>((raw & 1) | (raw == saturated_free_raw));
+  };
   const auto clearCell = [&](std::int16_t* p) {
     const std::size_t i = static_cast<std::size_t>(p - cells);
     if (update(i, miss)) {
@@ -113,11 +118,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     int left = walk.stepsLeft();
     walked += static_cast<std::size_t>(left);
     for (; left > 0; --left) {
-      const std::int16_t raw = *p;
-      // Skip cells flagged (hit or cleared in this scan) or already saturated free: one
-      // combined, almost always taken test.
-      const bool skip = (raw & 1) | (raw == saturated_free_raw);
-      if (__builtin_expect(!skip, 0)) clearCell(p);
+      if (__builtin_expect(!skipsMiss(*p), 0)) clearCell(p);
       if (err <= 0) {
         p += dpx;
         err += esx;
@@ -128,7 +129,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     }
     if (beam.clear_end_cell || end_clipped) {
       ++walked;
-      if (!(*p & 1) && *p != saturated_free_raw) clearCell(p);
+      if (!skipsMiss(*p)) clearCell(p);
     }
   }
   stats.cells_cleared = walked;

@@ -52,10 +52,10 @@ void InflationLayer::updateBounds(double, double, double, double* min_x, double*
   std::lock_guard<std::mutex> lock(mutex_);
   if (need_full_window_) {
     const GridGeometry& g = layered_costmap_->costmap().geometry();
-    *min_x = std::min(*min_x, g.originX());
-    *min_y = std::min(*min_y, g.originY());
-    *max_x = std::max(*max_x, g.originX() + (g.sizeX() - 0.5) * g.resolution());
-    *max_y = std::max(*max_y, g.originY() + (g.sizeY() - 0.5) * g.resolution());
+    CellBounds all;
+    all.expand(0, 0);
+    all.expand(g.sizeX() - 1, g.sizeY() - 1);
+    g.expandWorldBox(all, min_x, min_y, max_x, max_y);
     need_full_window_ = false;
     return;
   }

@@ -114,13 +114,7 @@ void LogOddsObstacleLayer::updateBounds(double, double, double, double* min_x, d
   for (const auto& source : sources_) current = current && source->isCurrent();
   current_ = current;
   std::lock_guard<std::mutex> lock(grid_mutex_);
-  if (dirty_.empty()) return;
-  const GridGeometry& g = grid_.geometry();
-  *min_x = std::min(*min_x, g.originX() + dirty_.min_x * g.resolution());
-  *min_y = std::min(*min_y, g.originY() + dirty_.min_y * g.resolution());
-  // The far corner of the last cell lies on the next cell's edge: stay half a cell inside it.
-  *max_x = std::max(*max_x, g.originX() + (dirty_.max_x + 0.5) * g.resolution());
-  *max_y = std::max(*max_y, g.originY() + (dirty_.max_y + 0.5) * g.resolution());
+  grid_.geometry().expandWorldBox(dirty_, min_x, min_y, max_x, max_y);
   dirty_ = CellBounds{};
 }
 

@@ -9,9 +9,7 @@ import unittest
 import numpy as np
 import rospy
 import rostest
-from diagnostic_msgs.msg import DiagnosticArray
-from nav_msgs.msg import OccupancyGrid
-from std_msgs.msg import Bool
+from costmap_watch import CostmapWatch
 
 from downstream_perception.sim import warehouse_aisle
 
@@ -25,41 +23,19 @@ class CostmapAisleTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls) -> None:
         rospy.init_node("test_costmap_aisle")
-        cls.latest: OccupancyGrid | None = None
-        cls.latest_wall = 0.0
-        cls.done_wall: float | None = None
-        cls.layer_status: dict[str, str] = {}
-
-        def on_grid(msg: OccupancyGrid) -> None:
-            cls.latest = msg
-            cls.latest_wall = time.time()
-
-        def on_done(msg: Bool) -> None:
-            if msg.data and cls.done_wall is None:
-                cls.done_wall = time.time()
-
-        def on_diag(msg: DiagnosticArray) -> None:
-            for status in msg.status:
-                if "layer obstacles" in status.name:
-                    cls.layer_status = {kv.key: kv.value for kv in status.values}
-
-        rospy.Subscriber("/costmap/costmap", OccupancyGrid, on_grid, queue_size=1)
-        rospy.Subscriber("/sim_done", Bool, on_done, queue_size=1)
-        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=10)
-        deadline = time.time() + 90.0
-        while cls.done_wall is None and time.time() < deadline and not rospy.is_shutdown():
-            time.sleep(0.1)
-        assert cls.done_wall is not None, "the simulator never reported sim_done"
+        watch = CostmapWatch("obstacles")
+        cls.watch = watch
+        watch.wait_for_drive_end()
         # The run at 2.5 m/s ends near t = 7 s; the person leaves at t = 8 s. Give the robot a few
         # scans of the empty crossing from its final pose, then take a map published after that.
         time.sleep(max(0.0, PERSON_GONE_S - 6.0) + 2.5)
         taken = time.time()
-        while cls.latest_wall <= taken and time.time() < taken + 10.0:
+        while watch.latest_wall <= taken and time.time() < taken + 10.0:
             time.sleep(0.1)
-        assert cls.latest is not None, "no costmap was published"
-        info = cls.latest.info
+        assert watch.latest is not None, "no costmap was published"
+        info = watch.latest.info
         cls.info = info
-        cls.grid = np.asarray(cls.latest.data, dtype=np.int8).reshape(info.height, info.width)
+        cls.grid = np.asarray(watch.latest.data, dtype=np.int8).reshape(info.height, info.width)
         ys, xs = np.mgrid[0 : info.height, 0 : info.width]
         cls.wx = info.origin.position.x + (xs + 0.5) * info.resolution
         cls.wy = info.origin.position.y + (ys + 0.5) * info.resolution
@@ -116,11 +92,13 @@ class CostmapAisleTest(unittest.TestCase):
 
     def test_diagnostics_report_integration(self) -> None:
         deadline = time.time() + 5.0
-        while "scan: scans integrated" not in self.layer_status and time.time() < deadline:
+        while "scan: scans integrated" not in self.watch.layer_status and time.time() < deadline:
             time.sleep(0.1)
-        self.assertGreater(int(self.layer_status["scan: scans integrated"]), 20)
-        self.assertEqual(int(self.layer_status["scan: scans rejected"]), 0)
-        self.assertGreater(float(self.layer_status["scan: clear:mark ratio (all scans)"]), 5.0)
+        self.assertGreater(int(self.watch.layer_status["scan: scans integrated"]), 20)
+        self.assertEqual(int(self.watch.layer_status["scan: scans rejected"]), 0)
+        self.assertGreater(
+            float(self.watch.layer_status["scan: clear:mark ratio (all scans)"]), 5.0
+        )
 
 
 if __name__ == "__main__":

@@ -87,6 +87,10 @@ class GridGeometry {
   }
   /// Cell window covering a world box, clamped to the grid; empty if it misses the grid.
   CellBounds worldBoxToCells(double min_x, double min_y, double max_x, double max_y) const;
+  /// Grows the world box (m) to cover `cells` (the inverse of worldBoxToCells). The far corner
+  /// stays half a cell inside the last cell: its edge belongs to the next cell.
+  void expandWorldBox(const CellBounds& cells, double* min_x, double* min_y, double* max_x,
+                      double* max_y) const;
 
   bool operator==(const GridGeometry& o) const {
     return size_x_ == o.size_x_ && size_y_ == o.size_y_ && resolution_ == o.resolution_ &&
