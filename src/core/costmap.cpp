@@ -1,5 +1,7 @@
 #include "downstream_perception/core/costmap.h"
 
+#include "downstream_perception/core/grid_shift.h"
+
 #include <algorithm>
 
 namespace downstream_perception {
@@ -38,24 +40,8 @@ void Costmap::resetWindow(const CellBounds& window) {
 }
 
 void Costmap::shift(int dx, int dy) {
-  if (dx == 0 && dy == 0) return;
-  const int nx = geometry_.sizeX();
-  const int ny = geometry_.sizeY();
-  std::vector<std::uint8_t> shifted(cells_.size(), default_value_);
-  const int x_lo = std::max(0, dx);
-  const int x_hi = std::min(nx, nx + dx);
-  const int y_lo = std::max(0, dy);
-  const int y_hi = std::min(ny, ny + dy);
-  if (x_lo < x_hi) {
-    for (int y = y_lo; y < y_hi; ++y) {
-      const auto* src = cells_.data() + geometry_.index(x_lo, y);
-      std::copy(src, src + (x_hi - x_lo), shifted.data() + geometry_.index(x_lo - dx, y - dy));
-    }
-  }
-  cells_.swap(shifted);
-  geometry_ = GridGeometry(nx, ny, geometry_.resolution(),
-                           geometry_.originX() + dx * geometry_.resolution(),
-                           geometry_.originY() + dy * geometry_.resolution());
+  shiftGridData(&cells_, geometry_.sizeX(), geometry_.sizeY(), dx, dy, default_value_);
+  geometry_ = shiftedGeometry(geometry_, dx, dy);
 }
 
 }  // namespace downstream_perception

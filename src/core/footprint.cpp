@@ -72,3 +72,61 @@ double circumscribedRadius(const Footprint& polygon) {
 }
 
 }  // namespace downstream_perception
+
+namespace downstream_perception {
+
+Footprint transformFootprint(const Footprint& polygon, const Pose2D& pose) {
+  Footprint out;
+  out.reserve(polygon.size());
+  for (const FootprintPoint& p : polygon) {
+    const Point2 q = apply(pose, Point2{p.x, p.y});
+    out.push_back({q.x, q.y});
+  }
+  return out;
+}
+
+CellBounds polygonCells(const Footprint& world_polygon, const GridGeometry& g,
+                        std::vector<std::size_t>* cells) {
+  CellBounds window;
+  if (world_polygon.size() < 3 || g.cellCount() == 0) return window;
+  double min_y = std::numeric_limits<double>::max();
+  double max_y = std::numeric_limits<double>::lowest();
+  for (const FootprintPoint& p : world_polygon) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) return window;
+    min_y = std::min(min_y, p.y);
+    max_y = std::max(max_y, p.y);
+  }
+  const double res = g.resolution();
+  // Rows whose centre line can cross the polygon, clipped to the grid.
+  const int row_lo = std::max(0, static_cast<int>(std::floor((min_y - g.originY()) / res - 0.5)));
+  const int row_hi =
+      std::min(g.sizeY() - 1, static_cast<int>(std::ceil((max_y - g.originY()) / res - 0.5)));
+  std::vector<double> crossings;
+  const std::size_t n = world_polygon.size();
+  for (int cy = row_lo; cy <= row_hi; ++cy) {
+    const double y = g.originY() + (cy + 0.5) * res;
+    crossings.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+      const FootprintPoint& a = world_polygon[k];
+      const FootprintPoint& b = world_polygon[(k + 1) % n];
+      // Half-open in y so a vertex on the scan line is counted once.
+      if ((a.y <= y) == (b.y <= y)) continue;
+      crossings.push_back(a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y));
+    }
+    std::sort(crossings.begin(), crossings.end());
+    for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+      // Cells whose centre x lies in [x0, x1].
+      const int c0 = std::max(
+          0, static_cast<int>(std::ceil((crossings[k] - g.originX()) / res - 0.5)));
+      const int c1 = std::min(
+          g.sizeX() - 1, static_cast<int>(std::floor((crossings[k + 1] - g.originX()) / res - 0.5)));
+      if (c0 > c1) continue;
+      window.expand(c0, cy);
+      window.expand(c1, cy);
+      for (int cx = c0; cx <= c1; ++cx) cells->push_back(g.index(cx, cy));
+    }
+  }
+  return window;
+}
+
+}  // namespace downstream_perception

@@ -1,7 +1,10 @@
 #include "downstream_perception/core/inflation.h"
 
+#include "downstream_perception/core/grid_shift.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -153,7 +156,73 @@ void Inflator::resizeTo(const GridGeometry& geometry) {
   const int tiles_x = (geometry.sizeX() >> kTileShift) + 1;
   const int tiles_y = (geometry.sizeY() >> kTileShift) + 1;
   dirty_tiles_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, 0);
+  dirty_tile_count_ = 0;
+  dirty_tile_box_ = CellBounds{};
   full_recompute_ = true;
+}
+
+void Inflator::shift(int dx, int dy) {
+  if (dx == 0 && dy == 0) return;
+  if (full_recompute_ || geometry_.cellCount() == 0) {
+    // Nothing cached worth moving: the next update recomputes everything anyway.
+    if (geometry_.cellCount() > 0) geometry_ = shiftedGeometry(geometry_, dx, dy);
+    return;
+  }
+  const int nx = geometry_.sizeX();
+  const int ny = geometry_.sizeY();
+  if (std::abs(dx) >= nx || std::abs(dy) >= ny) {
+    geometry_ = shiftedGeometry(geometry_, dx, dy);
+    full_recompute_ = true;
+    return;
+  }
+  shiftGridData(&lethal_, nx, ny, dx, dy, std::uint8_t{0});
+  shiftGridData(&costs_, nx, ny, dx, dy, std::uint8_t{0});
+  geometry_ = shiftedGeometry(geometry_, dx, dy);
+  // Pending marks referred to the old origin: rather than move them, mark their area in the
+  // new frame conservatively by recomputing wherever anything was pending.
+  if (dirty_tile_count_ > 0) {
+    CellBounds pending;
+    pending.expand((dirty_tile_box_.min_x << kTileShift) - dx,
+                   (dirty_tile_box_.min_y << kTileShift) - dy);
+    pending.expand(((dirty_tile_box_.max_x + 1) << kTileShift) - 1 - dx,
+                   ((dirty_tile_box_.max_y + 1) << kTileShift) - 1 - dy);
+    std::fill(dirty_tiles_.begin(), dirty_tiles_.end(), 0);
+    dirty_tile_count_ = 0;
+    dirty_tile_box_ = CellBounds{};
+    markDirty(pending);
+  }
+  // Cells that came into view need costs from the lethal cells near them; cells along the edge
+  // the map moved away from may have lost the lethal cells that inflated them. A marked tile is
+  // recomputed out to the inflation radius, so marking the edge row of tiles covers that band.
+  if (dx > 0) {
+    markDirty({nx - dx, 0, nx - 1, ny - 1});
+    markDirty({0, 0, 0, ny - 1});
+  } else if (dx < 0) {
+    markDirty({0, 0, -dx - 1, ny - 1});
+    markDirty({nx - 1, 0, nx - 1, ny - 1});
+  }
+  if (dy > 0) {
+    markDirty({0, ny - dy, nx - 1, ny - 1});
+    markDirty({0, 0, nx - 1, 0});
+  } else if (dy < 0) {
+    markDirty({0, 0, nx - 1, -dy - 1});
+    markDirty({0, ny - 1, nx - 1, ny - 1});
+  }
+}
+
+void Inflator::markDirty(const CellBounds& cells) {
+  const CellBounds c = grow(cells, 0, geometry_);
+  if (c.empty()) return;
+  const int tiles_x = (geometry_.sizeX() >> kTileShift) + 1;
+  for (int ty = c.min_y >> kTileShift; ty <= (c.max_y >> kTileShift); ++ty) {
+    for (int tx = c.min_x >> kTileShift; tx <= (c.max_x >> kTileShift); ++tx) {
+      std::uint8_t& tile = dirty_tiles_[static_cast<std::size_t>(ty) * tiles_x + tx];
+      if (tile) continue;
+      tile = 1;
+      ++dirty_tile_count_;
+      dirty_tile_box_.expand(tx, ty);
+    }
+  }
 }
 
 void Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
@@ -168,6 +237,43 @@ void Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
   }
 }
 
+void Inflator::recomputeDirtyTiles(const GridGeometry& g, InflationStats* stats) {
+  if (dirty_tile_count_ == 0) return;
+  const int tiles_x = (g.sizeX() >> kTileShift) + 1;
+  const auto tileCells = [&](int tx, int ty) {
+    CellBounds b;
+    b.expand(tx << kTileShift, ty << kTileShift);
+    b.expand(((tx + 1) << kTileShift) - 1, ((ty + 1) << kTileShift) - 1);
+    return grow(b, radius_cells_, g);  // cells whose distance may have changed
+  };
+  // One region over all dirty tiles when that is cheaper than one region per tile.
+  CellBounds merged = tileCells(dirty_tile_box_.min_x, dirty_tile_box_.min_y);
+  merged.expand(tileCells(dirty_tile_box_.max_x, dirty_tile_box_.max_y));
+  const std::size_t per_tile =
+      dirty_tile_count_ *
+      area(grow(tileCells(dirty_tile_box_.min_x, dirty_tile_box_.min_y), radius_cells_, g));
+  const bool one_region = area(grow(merged, radius_cells_, g)) <= per_tile;
+  for (int ty = dirty_tile_box_.min_y; ty <= dirty_tile_box_.max_y; ++ty) {
+    for (int tx = dirty_tile_box_.min_x; tx <= dirty_tile_box_.max_x; ++tx) {
+      std::uint8_t& tile = dirty_tiles_[static_cast<std::size_t>(ty) * tiles_x + tx];
+      if (!tile) continue;
+      tile = 0;
+      if (one_region) continue;
+      const CellBounds region = tileCells(tx, ty);
+      recompute(region, g);
+      ++stats->regions;
+      stats->cells_recomputed += area(region);
+    }
+  }
+  if (one_region) {
+    recompute(merged, g);
+    stats->regions = 1;
+    stats->cells_recomputed = area(merged);
+  }
+  dirty_tile_count_ = 0;
+  dirty_tile_box_ = CellBounds{};
+}
+
 InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
   InflationStats stats;
   const GridGeometry& g = master->geometry();
@@ -175,7 +281,6 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
   if (!(g == geometry_)) resizeTo(g);
   const std::uint8_t* m = master->data();
   const int size_x = g.sizeX();
-  const int tiles_x = (g.sizeX() >> kTileShift) + 1;
   const CellBounds w = master->clamp(window);
 
   if (full_recompute_) {
@@ -188,11 +293,13 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
     recompute(all, g);
     stats.regions = 1;
     stats.cells_recomputed = g.cellCount();
+    std::fill(dirty_tiles_.begin(), dirty_tiles_.end(), 0);
+    dirty_tile_count_ = 0;
+    dirty_tile_box_ = CellBounds{};
     full_recompute_ = false;
   } else {
     // Where did the set of lethal cells change?
-    CellBounds dirty_tile_box;
-    std::size_t dirty_tile_count = 0;
+    const int tiles_x = (g.sizeX() >> kTileShift) + 1;
     for (int y = w.min_y; !w.empty() && y <= w.max_y; ++y) {
       const std::size_t row = static_cast<std::size_t>(y) * size_x;
       for (int x = w.min_x; x <= w.max_x; ++x) {
@@ -205,43 +312,12 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
         std::uint8_t& tile = dirty_tiles_[static_cast<std::size_t>(ty) * tiles_x + tx];
         if (!tile) {
           tile = 1;
-          ++dirty_tile_count;
-          dirty_tile_box.expand(tx, ty);
+          ++dirty_tile_count_;
+          dirty_tile_box_.expand(tx, ty);
         }
       }
     }
-    if (dirty_tile_count > 0) {
-      const auto tileCells = [&](int tx, int ty) {
-        CellBounds b;
-        b.expand(tx << kTileShift, ty << kTileShift);
-        b.expand(((tx + 1) << kTileShift) - 1, ((ty + 1) << kTileShift) - 1);
-        return grow(b, radius_cells_, g);  // cells whose distance may have changed
-      };
-      // One region over all dirty tiles when that is cheaper than one region per tile.
-      CellBounds merged = tileCells(dirty_tile_box.min_x, dirty_tile_box.min_y);
-      merged.expand(tileCells(dirty_tile_box.max_x, dirty_tile_box.max_y));
-      const std::size_t per_tile =
-          dirty_tile_count *
-          area(grow(tileCells(dirty_tile_box.min_x, dirty_tile_box.min_y), radius_cells_, g));
-      const bool one_region = area(grow(merged, radius_cells_, g)) <= per_tile;
-      for (int ty = dirty_tile_box.min_y; ty <= dirty_tile_box.max_y; ++ty) {
-        for (int tx = dirty_tile_box.min_x; tx <= dirty_tile_box.max_x; ++tx) {
-          std::uint8_t& tile = dirty_tiles_[static_cast<std::size_t>(ty) * tiles_x + tx];
-          if (!tile) continue;
-          tile = 0;
-          if (one_region) continue;
-          const CellBounds region = tileCells(tx, ty);
-          recompute(region, g);
-          ++stats.regions;
-          stats.cells_recomputed += area(region);
-        }
-      }
-      if (one_region) {
-        recompute(merged, g);
-        stats.regions = 1;
-        stats.cells_recomputed = area(merged);
-      }
-    }
+    recomputeDirtyTiles(g, &stats);
   }
 
   // Merge into the master over the window (costmap_2d's InflationLayer rule).

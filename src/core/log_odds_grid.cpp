@@ -1,5 +1,7 @@
 #include "downstream_perception/core/log_odds_grid.h"
 
+#include "downstream_perception/core/grid_shift.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -106,27 +108,43 @@ void LogOddsGrid::countStates(std::size_t* free_cells, std::size_t* occupied_cel
   *unknown_cells = cells_.size() - n_free - n_occ;
 }
 
-void LogOddsGrid::shift(int dx, int dy) {
-  if (dx == 0 && dy == 0) return;
-  const int nx = geometry_.sizeX();
-  const int ny = geometry_.sizeY();
-  std::vector<std::int16_t> shifted(cells_.size(), 0);
-  // Overlap of the old grid [dx, dx + nx) x [dy, dy + ny) with [0, nx) x [0, ny).
-  const int x_lo = std::max(0, dx);
-  const int x_hi = std::min(nx, nx + dx);
-  const int y_lo = std::max(0, dy);
-  const int y_hi = std::min(ny, ny + dy);
-  if (x_lo < x_hi) {
-    for (int y = y_lo; y < y_hi; ++y) {
-      const auto src = cells_.begin() + static_cast<std::ptrdiff_t>(geometry_.index(x_lo, y));
-      std::copy(src, src + (x_hi - x_lo),
-                shifted.begin() + static_cast<std::ptrdiff_t>(geometry_.index(x_lo - dx, y - dy)));
+CellBounds LogOddsGrid::decay(double factor, const CellBounds& window,
+                              std::size_t* changed_cells) {
+  CellBounds changed;
+  if (!(factor >= 0.0 && factor <= 1.0)) {
+    throw std::invalid_argument("LogOddsGrid::decay: factor must be in [0, 1], got " +
+                                std::to_string(factor));
+  }
+  CellBounds w;
+  w.min_x = std::max(window.min_x, 0);
+  w.min_y = std::max(window.min_y, 0);
+  w.max_x = std::min(window.max_x, geometry_.sizeX() - 1);
+  w.max_y = std::min(window.max_y, geometry_.sizeY() - 1);
+  if (w.empty() || factor == 1.0) return changed;
+  // Fixed-point factor (16 fractional bits); C++ division truncates toward zero, so a cell never
+  // crosses zero and always reaches exactly 0 (unknown).
+  const std::int64_t f = std::llround(factor * 65536.0);
+  std::size_t count = 0;
+  for (int y = w.min_y; y <= w.max_y; ++y) {
+    std::int16_t* row = cells_.data() + geometry_.index(0, y);
+    for (int x = w.min_x; x <= w.max_x; ++x) {
+      const int before = unitsOfRaw(row[x]);
+      if (before == 0) continue;
+      const int after = static_cast<int>(before * f / 65536);
+      row[x] = static_cast<std::int16_t>(after * 2 + (row[x] & 1));
+      if (stateOfUnits(before) != stateOfUnits(after)) {
+        changed.expand(x, y);
+        ++count;
+      }
     }
   }
-  cells_.swap(shifted);
-  geometry_ = GridGeometry(nx, ny, geometry_.resolution(),
-                           geometry_.originX() + dx * geometry_.resolution(),
-                           geometry_.originY() + dy * geometry_.resolution());
+  if (changed_cells != nullptr) *changed_cells += count;
+  return changed;
+}
+
+void LogOddsGrid::shift(int dx, int dy) {
+  shiftGridData(&cells_, geometry_.sizeX(), geometry_.sizeY(), dx, dy, std::int16_t{0});
+  geometry_ = shiftedGeometry(geometry_, dx, dy);
 }
 
 }  // namespace downstream_perception

@@ -15,6 +15,7 @@ void IntegrationStats::accumulate(const IntegrationStats& o) {
   beams_no_return += o.beams_no_return;
   beams_invalid += o.beams_invalid;
   beams_beyond_obstacle_range += o.beams_beyond_obstacle_range;
+  points_outside_height += o.points_outside_height;
   cells_cleared += o.cells_cleared;
   cells_marked += o.cells_marked;
   cells_changed += o.cells_changed;
@@ -262,6 +263,33 @@ void ScanIntegrator::beamsFromScan(const LaserScanView& scan, const Pose2D& sens
   }
 }
 
+void ScanIntegrator::beamsFromMovingScan(const LaserScanView& scan, const Pose2D& first_beam_pose,
+                                         const Pose2D& last_beam_pose,
+                                         std::vector<BeamUpdate>* beams,
+                                         IntegrationStats* stats) const {
+  beams->reserve(beams->size() + scan.count);
+  const double last = scan.count > 1 ? static_cast<double>(scan.count - 1) : 1.0;
+  for (std::size_t k = 0; k < scan.count; ++k) {
+    const Pose2D pose =
+        interpolate(first_beam_pose, 0.0, last_beam_pose, last, static_cast<double>(k));
+    const double angle = pose.yaw + scan.angle_min + static_cast<double>(k) * scan.angle_increment;
+    beamFromDirection(pose.x, pose.y, std::cos(angle), std::sin(angle),
+                      static_cast<double>(scan.ranges[k]), scan.range_min, scan.range_max, beams,
+                      stats);
+  }
+}
+
+IntegrationStats ScanIntegrator::integrate(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
+                                           const IntegrationStats& decisions) {
+  IntegrationStats stats = integrateBeams(grid, beams, &flagged_scratch_);
+  stats.beams = decisions.beams;
+  stats.beams_invalid = decisions.beams_invalid;
+  stats.beams_no_return = decisions.beams_no_return;
+  stats.beams_beyond_obstacle_range = decisions.beams_beyond_obstacle_range;
+  stats.points_outside_height = decisions.points_outside_height;
+  return stats;
+}
+
 IntegrationStats ScanIntegrator::integrate(LogOddsGrid& grid, const LaserScanView& scan,
                                            const Pose2D& sensor_pose) {
   const std::string why = scan.validate();
@@ -269,12 +297,7 @@ IntegrationStats ScanIntegrator::integrate(LogOddsGrid& grid, const LaserScanVie
   scratch_.clear();
   IntegrationStats decisions;
   beamsFromScan(scan, sensor_pose, &scratch_, &decisions);
-  IntegrationStats stats = integrateBeams(grid, scratch_, &flagged_scratch_);
-  stats.beams = decisions.beams;
-  stats.beams_invalid = decisions.beams_invalid;
-  stats.beams_no_return = decisions.beams_no_return;
-  stats.beams_beyond_obstacle_range = decisions.beams_beyond_obstacle_range;
-  return stats;
+  return integrate(grid, scratch_, decisions);
 }
 
 }  // namespace downstream_perception

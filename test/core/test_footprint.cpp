@@ -32,3 +32,52 @@ TEST(Footprint, RejectsDegenerateOrAbsurdPolygons) {
   EXPECT_FALSE(validateFootprint({{0, 0}, {1, 0}, {NAN, 1}}).empty());
   EXPECT_FALSE(validateFootprint({{0, 0}, {1e6, 0}, {0, 1}}).empty());
 }
+
+TEST(Footprint, PolygonCellsOfAnAlignedSquare) {
+  // A 0.6 m square centred on a cell corner at 5 cm covers exactly 12 x 12 cell centres.
+  const GridGeometry g(100, 100, 0.05, 0.0, 0.0);
+  const Footprint square = {{0.3, 0.3}, {-0.3, 0.3}, {-0.3, -0.3}, {0.3, -0.3}};
+  std::vector<std::size_t> cells;
+  const CellBounds b = polygonCells(transformFootprint(square, Pose2D{2.5, 2.5, 0.0}), g, &cells);
+  EXPECT_EQ(cells.size(), 144u);
+  EXPECT_EQ(b.min_x, 44);
+  EXPECT_EQ(b.max_x, 55);
+  EXPECT_EQ(b.min_y, 44);
+  EXPECT_EQ(b.max_y, 55);
+}
+
+TEST(Footprint, PolygonCellsRotatedClippedAndConcave) {
+  const GridGeometry g(100, 100, 0.05, 0.0, 0.0);
+  const Footprint square = {{0.3, 0.3}, {-0.3, 0.3}, {-0.3, -0.3}, {0.3, -0.3}};
+  // Rotated 45 deg: a diamond of half-diagonal 0.424 m; every chosen centre is inside.
+  std::vector<std::size_t> cells;
+  const Footprint diamond = transformFootprint(square, Pose2D{2.5, 2.5, M_PI / 4});
+  polygonCells(diamond, g, &cells);
+  const double area_cells = 0.36 / (0.05 * 0.05);  // 144
+  EXPECT_NEAR(static_cast<double>(cells.size()), area_cells, 0.1 * area_cells);
+  for (const std::size_t i : cells) {
+    const CellIndex c = g.cellOf(i);
+    double x = 0.0, y = 0.0;
+    g.cellCentre(c.x, c.y, &x, &y);
+    EXPECT_LE(std::abs(x - 2.5) + std::abs(y - 2.5), 0.3 * std::sqrt(2.0) + 1e-9);
+  }
+  // Clipped at the grid's corner: only the quarter inside the grid.
+  cells.clear();
+  polygonCells(transformFootprint(square, Pose2D{0.0, 0.0, 0.0}), g, &cells);
+  EXPECT_EQ(cells.size(), 36u);
+  // Entirely outside: nothing, empty window.
+  cells.clear();
+  EXPECT_TRUE(polygonCells(transformFootprint(square, Pose2D{-5.0, 2.0, 0.0}), g, &cells).empty());
+  EXPECT_TRUE(cells.empty());
+  // A concave "U" (even-odd rule): the notch stays out.
+  const Footprint u = {{0.0, 0.0}, {0.6, 0.0}, {0.6, 0.6}, {0.4, 0.6},
+                       {0.4, 0.2}, {0.2, 0.2}, {0.2, 0.6}, {0.0, 0.6}};
+  cells.clear();
+  polygonCells(transformFootprint(u, Pose2D{1.0, 1.0, 0.0}), g, &cells);
+  EXPECT_EQ(cells.size(), 144u - 4u * 8u);  // 12 x 12 minus the 4 x 8 notch
+  // Non-finite vertices: nothing.
+  cells.clear();
+  Footprint bad = square;
+  bad[1].x = std::nan("");
+  EXPECT_TRUE(polygonCells(bad, g, &cells).empty());
+}

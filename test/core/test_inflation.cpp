@@ -242,3 +242,66 @@ TEST(Inflator, RejectsAbsurdConfigs) {
   EXPECT_THROW(Inflator(InflationConfig{}, 0.0), std::invalid_argument);
   EXPECT_TRUE(InflationConfig{}.validate().empty());
 }
+
+TEST(Inflator, RollingWindowShiftsEqualFullRecomputation) {
+  // A robot-centred window moving over a fixed random world: after each whole-cell shift (and
+  // the lethal cells that came into view), the shifted cache must equal a fresh inflation of the
+  // same window. Shifts cover +-x, +-y, diagonal, larger than a tile and larger than the radius.
+  std::mt19937 rng(29);
+  const GridGeometry world_g(400, 300, 0.05, -10.0, -7.5);
+  const Costmap world = randomLethalMap(world_g, 0.004, rng);
+  for (const double radius : {0.0, 0.3, 1.0}) {
+    InflationConfig c;
+    c.inflation_radius = radius;
+    c.inscribed_radius = 0.1;
+    const auto window_from_world = [&](const GridGeometry& g) {
+      Costmap m(g, cost::kNoInformation);
+      for (int y = 0; y < g.sizeY(); ++y) {
+        for (int x = 0; x < g.sizeX(); ++x) {
+          double wx = 0.0, wy = 0.0;
+          g.cellCentre(x, y, &wx, &wy);
+          CellIndex w;
+          if (world_g.worldToCell(wx, wy, &w)) m.setCost(x, y, world.cost(w.x, w.y));
+        }
+      }
+      return m;
+    };
+    GridGeometry g(120, 80, 0.05, -3.0, -2.0);
+    Costmap master = window_from_world(g);
+    Inflator inflator(c, g.resolution());
+    inflator.update(&master, everything(g));
+    const int moves[][2] = {{1, 0}, {0, -1}, {3, 2}, {-5, 7}, {40, 0}, {0, -33}, {-70, -9}, {2, 0}};
+    for (const auto& move : moves) {
+      master.shift(move[0], move[1]);
+      inflator.shift(move[0], move[1]);
+      g = master.geometry();
+      // What the layers would redraw: the whole window (the LayeredCostmap redraws all on a
+      // shift); the Inflator must still only recompute near the edges.
+      master = window_from_world(g);
+      const InflationStats stats = inflator.update(&master, everything(g));
+      EXPECT_LT(stats.cells_recomputed, g.cellCount() + 1);
+      Costmap fresh = window_from_world(g);
+      Inflator full(c, g.resolution());
+      full.update(&fresh, everything(g));
+      ASSERT_EQ(inflator.costs(), full.costs())
+          << "radius " << radius << " after move " << move[0] << "," << move[1];
+      ASSERT_EQ(master.cells(), fresh.cells()) << "radius " << radius;
+    }
+  }
+}
+
+TEST(Inflator, SmallShiftRecomputesOnlyTheEdges) {
+  std::mt19937 rng(31);
+  const GridGeometry g(400, 400, 0.05, 0.0, 0.0);
+  Costmap master = randomLethalMap(g, 0.002, rng);
+  InflationConfig c;
+  c.inflation_radius = 0.3;
+  Inflator inflator(c, g.resolution());
+  inflator.update(&master, everything(g));
+  master.shift(1, 0);
+  inflator.shift(1, 0);
+  const InflationStats stats = inflator.update(&master, everything(master.geometry()));
+  // Two 32-cell tile columns grown by the radius, far below the 160,000-cell map.
+  EXPECT_GT(stats.cells_recomputed, 0u);
+  EXPECT_LT(stats.cells_recomputed, g.cellCount() / 2);
+}

@@ -51,3 +51,32 @@ TEST(WriteStateCosts, MatchesPerCellStateOnRandomGridsAndClampsTheWindow) {
   Costmap other(GridGeometry(5, 5, 0.05, 0.0, 0.0), 0);
   EXPECT_THROW(writeStateCosts(grid, window, true, 0, &other), std::invalid_argument);
 }
+
+TEST(LogOddsCosts, MaximumCombinationOnlyRaisesCosts) {
+  const GridGeometry geometry(4, 1, 0.05, 0.0, 0.0);
+  LogOddsGrid grid(geometry);
+  grid.setLogOdds(0, 8.0);   // occupied
+  grid.setLogOdds(1, -8.0);  // free
+  grid.setLogOdds(2, -8.0);  // free
+  // cell 3 unknown
+  Costmap master(geometry, cost::kNoInformation);
+  master.setCost(0, 0, 100);
+  master.setCost(1, 0, 100);
+  // master cell 2 is NO_INFORMATION, cell 3 holds 50
+  master.setCost(3, 0, 50);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(3, 0);
+  writeStateCosts(grid, all, false, cost::kFreeSpace, &master, CombinationMethod::kMaximum);
+  EXPECT_EQ(master.cost(0, 0), cost::kLethalObstacle);  // 254 > 100
+  EXPECT_EQ(master.cost(1, 0), 100);                     // free does not lower an earlier cost
+  EXPECT_EQ(master.cost(2, 0), cost::kFreeSpace);        // NO_INFORMATION is always replaced
+  EXPECT_EQ(master.cost(3, 0), 50);                      // unknown writes nothing
+  // Overwrite on the same input lowers cell 1.
+  master.setCost(1, 0, 100);
+  writeStateCosts(grid, all, false, cost::kFreeSpace, &master, CombinationMethod::kOverwrite);
+  EXPECT_EQ(master.cost(1, 0), cost::kFreeSpace);
+  EXPECT_TRUE(validateCombinationMethod(0).empty());
+  EXPECT_TRUE(validateCombinationMethod(1).empty());
+  EXPECT_FALSE(validateCombinationMethod(99).empty());
+}

@@ -179,3 +179,31 @@ TEST(LogOdds, CountsStatesAndShifts) {
   EXPECT_EQ(g.state(g.geometry().index(2, 1)), CellState::kFree);
   EXPECT_EQ(g.state(g.geometry().index(3, 2)), CellState::kUnknown);  // newly exposed
 }
+
+TEST(LogOdds, DecayFadesTowardUnknownAndReportsStateChanges) {
+  const GridGeometry geometry(4, 1, 0.05, 0.0, 0.0);
+  LogOddsGrid g(geometry);
+  g.setLogOdds(0, 8.0);   // saturated obstacle
+  g.setLogOdds(1, -8.0);  // saturated free
+  g.setLogOdds(2, 2.5);   // barely occupied
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(3, 0);
+  // tau = 1 s, dt = 0.5 s: factor exp(-0.5) = 0.6065.
+  std::size_t changed = 0;
+  CellBounds window = g.decay(std::exp(-0.5), all, &changed);
+  EXPECT_NEAR(g.logOdds(0), 8.0 * std::exp(-0.5), 2 * LogOddsGrid::kQuantum);
+  EXPECT_NEAR(g.logOdds(1), -8.0 * std::exp(-0.5), 2 * LogOddsGrid::kQuantum);
+  EXPECT_EQ(g.state(2), CellState::kUnknown);  // 2.5 -> 1.52: below the occupied threshold
+  EXPECT_EQ(changed, 1u);
+  EXPECT_EQ(window.min_x, 2);
+  EXPECT_EQ(window.max_x, 2);
+  // A saturated obstacle stops being lethal after tau * ln(8 / 2) = 1.386 s.
+  for (int k = 0; k < 2; ++k) g.decay(std::exp(-0.5), all);  // t = 1.5 s
+  EXPECT_EQ(g.state(0), CellState::kUnknown);
+  // Decay never crosses zero and reaches it exactly.
+  for (int k = 0; k < 40; ++k) g.decay(0.5, all);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(g.units(i), 0) << i;
+  EXPECT_THROW(g.decay(1.5, all), std::invalid_argument);
+  EXPECT_THROW(g.decay(std::nan(""), all), std::invalid_argument);
+}

@@ -1,8 +1,12 @@
 // Robot footprint: a polygon in the base frame (REP-103: x forward, y left, metres).
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
+
+#include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/se2.h"
 
 namespace downstream_perception {
 
@@ -24,5 +28,13 @@ Footprint padFootprint(const Footprint& polygon, double padding_m);
 double inscribedRadius(const Footprint& polygon);
 /// Largest distance from the origin to a vertex (circumscribed radius).
 double circumscribedRadius(const Footprint& polygon);
+
+/// The polygon placed at `pose` (world <- base) in world coordinates.
+Footprint transformFootprint(const Footprint& polygon, const Pose2D& pose);
+/// Indices of the grid cells whose centre lies inside the polygon (given in world coordinates;
+/// even-odd rule, so concave polygons work), clipped to the grid, row by row. Appends to *cells
+/// and returns the window they span (empty if none).
+CellBounds polygonCells(const Footprint& world_polygon, const GridGeometry& geometry,
+                        std::vector<std::size_t>* cells);
 
 }  // namespace downstream_perception

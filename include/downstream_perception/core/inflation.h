@@ -68,6 +68,10 @@ class Inflator {
   void setConfig(const InflationConfig& config, double resolution_m);
   /// Forget the cache: the next update recomputes the whole map.
   void reset() { full_recompute_ = true; }
+  /// Rolling window: the master's origin moved by (dx, dy) whole cells. The cache moves with it;
+  /// the next update recomputes only near the edges (cells that came into view, and cells that
+  /// lost lethal sources which left the map), not the whole map.
+  void shift(int dx, int dy);
 
   /// Inflation radius in whole cells (cells up to this distance may get a cost).
   int radiusCells() const { return radius_cells_; }
@@ -89,6 +93,10 @@ class Inflator {
  private:
   void resizeTo(const GridGeometry& geometry);
   void recompute(const CellBounds& region, const GridGeometry& geometry);
+  /// Marks the tiles covering `cells` (clamped) for recomputation at the next update.
+  void markDirty(const CellBounds& cells);
+  /// Recomputes every dirty tile's neighbourhood and clears the marks.
+  void recomputeDirtyTiles(const GridGeometry& geometry, InflationStats* stats);
 
   InflationConfig config_;
   double resolution_ = 0.0;
@@ -98,6 +106,8 @@ class Inflator {
   std::vector<std::uint8_t> lethal_;  ///< 1 where the master was lethal at the last update
   std::vector<std::uint8_t> costs_;
   std::vector<std::uint8_t> dirty_tiles_;
+  std::size_t dirty_tile_count_ = 0;
+  CellBounds dirty_tile_box_;  ///< in tiles
   std::vector<std::int32_t> scratch_;
   bool full_recompute_ = true;
 };

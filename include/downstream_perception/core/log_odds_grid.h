@@ -103,6 +103,10 @@ class LogOddsGrid {
   /// Bytes used by the cell storage (2 per cell).
   std::size_t memoryBytes() const { return cells_.size() * sizeof(std::int16_t); }
 
+  /// Time decay toward unknown: every cell of `window` (inclusive, clamped) gets l <- l * factor,
+  /// rounded toward zero, factor in [0, 1] (e.g. exp(-dt / tau)). Returns the window of the cells
+  /// whose state (free/occupied/unknown) changed; counts them into *changed_cells if given.
+  CellBounds decay(double factor, const CellBounds& window, std::size_t* changed_cells = nullptr);
   /// Shifts the content so that cell (dx, dy) of the old grid becomes cell (0, 0); cells that come
   /// into view are unknown, cells that leave are dropped. The origin moves by (dx, dy) cells.
   void shift(int dx, int dy);

@@ -52,6 +52,7 @@ struct IntegrationStats {
   std::size_t beams_no_return = 0;  ///< +Inf (or range_max when treated so) beams that cleared
   std::size_t beams_invalid = 0;    ///< NaN, -Inf, outside [range_min, range_max]
   std::size_t beams_beyond_obstacle_range = 0;  ///< returns too far (or near) to mark
+  std::size_t points_outside_height = 0;  ///< cloud points outside [min, max]_obstacle_height
   /// Cells walked by clearing rays, per beam (a cell two beams cross counts twice, as in the
   /// lesson's "a 10 m beam clears ~200 cells"). Each cell still receives at most one miss
   /// update per scan, and none if it was hit in the same scan.
@@ -110,6 +111,12 @@ class ScanIntegrator {
   /// in the grid's frame. Appends to *beams; counts ignored beams into *stats.
   void beamsFromScan(const LaserScanView& scan, const Pose2D& sensor_pose,
                      std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
+  /// Same for a scan taken while the sensor moved: beam k is cast from the pose interpolated
+  /// (linear in x, y; shortest arc in yaw) between the pose at the first beam and the pose at the
+  /// last beam. This is the per-beam time correction of a spinning lidar on a moving robot.
+  void beamsFromMovingScan(const LaserScanView& scan, const Pose2D& first_beam_pose,
+                           const Pose2D& last_beam_pose, std::vector<BeamUpdate>* beams,
+                           IntegrationStats* stats) const;
   /// Same for one measurement with its own sensor origin and direction (point clouds,
   /// per-beam de-skewed scans): range may be NaN / +-Inf with the scan semantics.
   void beamFromRange(double origin_x, double origin_y, double direction_rad, double range,
@@ -120,6 +127,10 @@ class ScanIntegrator {
                          double range, double range_min, double range_max,
                          std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
 
+  /// integrateBeams over beams made by the beamsFrom* calls; the beam counts of `decisions`
+  /// (filled by those calls) are carried into the result.
+  IntegrationStats integrate(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
+                             const IntegrationStats& decisions);
   /// beamsFromScan + integrateBeams. Throws std::invalid_argument if scan.validate() fails.
   /// Not thread-safe (reuses a scratch buffer): one integrator per thread.
   IntegrationStats integrate(LogOddsGrid& grid, const LaserScanView& scan,

@@ -1,0 +1,54 @@
+#include "downstream_perception/core/cloud_beams.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+namespace downstream_perception {
+
+std::string CloudBeamsConfig::validate() const {
+  std::ostringstream why;
+  if (!std::isfinite(min_obstacle_height) || !std::isfinite(max_obstacle_height) ||
+      min_obstacle_height > max_obstacle_height) {
+    why << "need finite min_obstacle_height <= max_obstacle_height, got " << min_obstacle_height
+        << " and " << max_obstacle_height;
+  }
+  return why.str();
+}
+
+void beamsFromCloud(const ScanIntegrator& integrator, const CloudBeamsConfig& config,
+                    const unsigned char* xyz, std::size_t count, std::size_t stride_bytes,
+                    const Eigen::Isometry3d& grid_from_sensor, std::vector<BeamUpdate>* beams,
+                    IntegrationStats* stats) {
+  beams->reserve(beams->size() + count);
+  const Eigen::Matrix3d r = grid_from_sensor.linear();
+  const Eigen::Vector3d t = grid_from_sensor.translation();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < count; ++k) {
+    float p[3];
+    std::memcpy(p, xyz + k * stride_bytes, sizeof(p));  // PointCloud2 data need not be aligned
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      ++stats->beams;
+      ++stats->beams_invalid;
+      continue;
+    }
+    const Eigen::Vector3d q = r * Eigen::Vector3d(p[0], p[1], p[2]) + t;
+    if (q.z() < config.min_obstacle_height || q.z() > config.max_obstacle_height) {
+      ++stats->points_outside_height;
+      continue;
+    }
+    const double dx = q.x() - t.x();
+    const double dy = q.y() - t.y();
+    const double range = std::hypot(dx, dy);
+    if (!(range > 0.0)) {
+      ++stats->beams;
+      ++stats->beams_invalid;  // straight above or below the sensor: no horizontal direction
+      continue;
+    }
+    integrator.beamFromDirection(t.x(), t.y(), dx / range, dy / range, range, 0.0, kInf, beams,
+                                 stats);
+  }
+}
+
+}  // namespace downstream_perception

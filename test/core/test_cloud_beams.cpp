@@ -1,0 +1,81 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "downstream_perception/core/cloud_beams.h"
+
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+struct PointXYZI {  // a typical PointCloud2 layout: x, y, z, intensity (16-byte point_step)
+  float x, y, z, intensity;
+};
+}  // namespace
+
+TEST(CloudBeams, HeightBandOriginAndInvalidPoints) {
+  ScanIntegratorConfig ic;
+  ic.obstacle_max_range = 4.0;
+  ic.raytrace_max_range = 5.0;
+  ScanIntegrator integrator(ic);
+  CloudBeamsConfig cc;
+  cc.min_obstacle_height = 0.1;
+  cc.max_obstacle_height = 1.5;
+  // Sensor 0.5 m up at (1, 2), looking along +x (identity rotation).
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(1.0, 2.0, 0.5);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<PointXYZI> cloud = {
+      {2.0f, 0.0f, 0.0f, 1.0f},    // z = 0.5 in the band: marks at (3, 2)
+      {2.0f, 0.0f, -0.45f, 1.0f},  // z = 0.05: floor, skipped
+      {2.0f, 0.0f, 1.2f, 1.0f},    // z = 1.7: above the band, skipped
+      {nan, 0.0f, 0.0f, 1.0f},     // depth hole: invalid
+      {0.0f, 0.0f, 0.5f, 1.0f},    // straight above the sensor: invalid
+      {0.0f, 4.5f, 0.0f, 1.0f},    // beyond obstacle_max_range: clears only
+  };
+  std::vector<BeamUpdate> beams;
+  IntegrationStats stats;
+  beamsFromCloud(integrator, cc, reinterpret_cast<const unsigned char*>(&cloud[0].x),
+                 cloud.size(), sizeof(PointXYZI), pose, &beams, &stats);
+  ASSERT_EQ(beams.size(), 2u);
+  EXPECT_EQ(stats.points_outside_height, 2u);
+  EXPECT_EQ(stats.beams_invalid, 2u);
+  EXPECT_EQ(stats.beams_beyond_obstacle_range, 1u);
+  EXPECT_TRUE(beams[0].mark);
+  EXPECT_NEAR(beams[0].hit_x, 3.0, 1e-9);
+  EXPECT_NEAR(beams[0].hit_y, 2.0, 1e-9);
+  EXPECT_NEAR(beams[0].start_x, 1.0, 1e-9);  // rays start at the sensor origin
+  EXPECT_NEAR(beams[0].start_y, 2.0, 1e-9);
+  EXPECT_FALSE(beams[1].mark);
+  EXPECT_TRUE(beams[1].clear);
+  EXPECT_NEAR(beams[1].end_y, 6.5, 1e-9);  // 4.5 m up the +y axis
+}
+
+TEST(CloudBeams, RotatedSensorAndIntegration) {
+  // A camera looking down the -y axis of the grid (yaw -90 deg): a point 2.025 m ahead and
+  // 0.025 m to its right lands at (-0.025, -2.025), a cell centre, which becomes occupied.
+  ScanIntegrator integrator(ScanIntegratorConfig{});
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  pose.translation().z() = 0.3;
+  const std::vector<PointXYZI> cloud = {{2.025f, -0.025f, 0.0f, 0.0f}};
+  LogOddsGrid grid(GridGeometry(100, 100, 0.05, -2.5, -2.5));
+  for (int k = 0; k < 6; ++k) {  // 6 misses: -2.43 < -2 (free); 6 hits: +5.08 (occupied)
+    std::vector<BeamUpdate> beams;
+    IntegrationStats stats;
+    beamsFromCloud(integrator, CloudBeamsConfig{}, reinterpret_cast<const unsigned char*>(&cloud[0].x),
+                   1, sizeof(PointXYZI), pose, &beams, &stats);
+    ASSERT_EQ(beams.size(), 1u);
+    EXPECT_NEAR(beams[0].hit_x, -0.025, 1e-6);
+    EXPECT_NEAR(beams[0].hit_y, -2.025, 1e-6);
+    integrator.integrate(grid, beams, stats);
+  }
+  CellIndex c;
+  ASSERT_TRUE(grid.geometry().worldToCell(-0.025, -2.025, &c));
+  EXPECT_EQ(grid.state(grid.geometry().index(c.x, c.y)), CellState::kOccupied);
+  ASSERT_TRUE(grid.geometry().worldToCell(-0.025, -1.025, &c));
+  EXPECT_EQ(grid.state(grid.geometry().index(c.x, c.y)), CellState::kFree);
+  EXPECT_FALSE((CloudBeamsConfig{1.0, 0.5}).validate().empty());
+  EXPECT_TRUE(CloudBeamsConfig{}.validate().empty());
+}
