@@ -42,8 +42,7 @@ class Demo:
         self.timeout_s = timeout_s
         self.rviz = rviz and shutil.which("Xvfb") is not None
         self.procs: list[subprocess.Popen[bytes]] = []
-        self.grid: Any = None
-        self.grid_time = 0.0
+        self.costmap: Any = None  # a CostmapClient once ROS is up
         self.diagnostics: dict[str, dict[str, str]] = {}
         self.sim_done = False
 
@@ -81,8 +80,9 @@ class Demo:
     def listen(self) -> None:
         import rospy
         from diagnostic_msgs.msg import DiagnosticArray
-        from nav_msgs.msg import OccupancyGrid
         from std_msgs.msg import Bool
+
+        from downstream_perception.costmap_client import CostmapClient
 
         deadline = time.time() + 30.0
         while True:
@@ -97,10 +97,6 @@ class Demo:
                 time.sleep(0.3)
         rospy.init_node("demo_report", anonymous=True, disable_signals=True)
 
-        def on_grid(msg: OccupancyGrid) -> None:
-            self.grid = msg
-            self.grid_time = time.time()
-
         def on_diag(msg: DiagnosticArray) -> None:
             for status in msg.status:
                 self.diagnostics[status.name] = {kv.key: kv.value for kv in status.values}
@@ -109,7 +105,7 @@ class Demo:
         def on_done(msg: Bool) -> None:
             self.sim_done = self.sim_done or bool(msg.data)
 
-        rospy.Subscriber("/costmap/costmap", OccupancyGrid, on_grid, queue_size=1)
+        self.costmap = CostmapClient("/costmap/costmap")  # full grid + ~costmap_updates
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=10)
         rospy.Subscriber("/sim_done", Bool, on_done, queue_size=1)
 
@@ -123,7 +119,7 @@ class Demo:
             time.sleep(0.2)
         run_s = time.time() - t0
         settle = time.time()
-        while self.grid_time < settle + 1.0 and time.time() - settle < 10.0:
+        while self.costmap.last_change_wall < settle + 1.0 and time.time() - settle < 10.0:
             time.sleep(0.2)  # one more costmap after the last scans
         return run_s
 
@@ -202,10 +198,10 @@ def main() -> None:
         png = demo.screenshot()
     finally:
         demo.stop()
-    if demo.grid is None:
+    if demo.costmap is None or not demo.costmap.received:
         raise SystemExit("demo: no costmap was published; see out/demo_launch.log")
 
-    summary = grid_summary(demo.grid)
+    summary = grid_summary(demo.costmap.message())
     layer = next((v for k, v in demo.diagnostics.items() if "layer obstacles" in k), {})
     costmap = next((v for k, v in demo.diagnostics.items() if k.endswith("costmap")), {})
     lines = [
@@ -220,12 +216,12 @@ def main() -> None:
     ]
     lines += [f"| {k} | {v} |" for k, v in summary.items()]
     for key in (
-        "scan: scans integrated",
-        "scan: scans rejected",
+        "scan: messages integrated",
+        "scan: messages rejected",
         "scan: integration time mean (ms)",
         "scan: integration time max (ms)",
         "scan: transform age at integration mean (s)",
-        "scan: clear:mark ratio (all scans)",
+        "scan: clear:mark ratio (all messages)",
         "max |log-odds|",
     ):
         if key in layer:

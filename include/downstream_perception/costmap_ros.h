@@ -1,36 +1,29 @@
-// ROS host of a LayeredCostmap: parameters, plugin loading, the update timer, publishing and
-// diagnostics. The nodelet and the node are thin shells around this class.
+// ROS host of a LayeredCostmap: parameters (YAML + dynamic_reconfigure), plugin loading, the
+// update timer (rolling window included), publishing (~costmap, ~costmap_updates, ~footprint),
+// the ~clear service and diagnostics. The nodelet and the node are thin shells around it.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include <boost/thread/recursive_mutex.hpp>
 #include <pluginlib/class_loader.hpp>
 
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
+#include "downstream_perception/CostmapConfig.h"
 #include "downstream_perception/costmap_publisher.h"
+#include "downstream_perception/costmap_ros_config.h"
 #include "downstream_perception/layered_costmap.h"
 #include "downstream_perception/running_stats.h"
 
 namespace downstream_perception {
-
-struct CostmapRosConfig {
-  std::string global_frame = "map";
-  std::string robot_base_frame = "base_link";
-  double update_frequency = 5.0;     ///< Hz
-  double publish_frequency = 1.0;    ///< Hz; 0 = never publish
-  double width = 10.0;               ///< m
-  double height = 10.0;              ///< m
-  double resolution = 0.05;          ///< m / cell
-  double origin_x = 0.0;             ///< m, lower-left corner in global_frame
-  double origin_y = 0.0;             ///< m
-  double transform_tolerance = 0.3;  ///< s: oldest acceptable robot pose
-  bool track_unknown_space = true;
-};
 
 class CostmapRos {
  public:
@@ -40,16 +33,20 @@ class CostmapRos {
   LayeredCostmap& layeredCostmap() { return *layered_costmap_; }
 
  private:
-  void readConfig();
+  using ReconfigureServer = dynamic_reconfigure::Server<CostmapConfig>;
   void loadPlugins();
+  void reconfigure(CostmapConfig& cfg, std::uint32_t level);
   void updateTimerCallback(const ros::TimerEvent& event);
   bool robotPose(double* x, double* y, double* yaw);
+  bool clearService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status);
-  void publishFootprint();
+  void applyFootprint();
+  void reportError(const std::string& msg);
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
   CostmapRosConfig config_;
+  std::mutex errors_mutex_;
   std::vector<std::string> config_errors_;
 
   std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
@@ -59,16 +56,22 @@ class CostmapRos {
   std::unique_ptr<LayeredCostmap> layered_costmap_;
   std::unique_ptr<CostmapPublisher> publisher_;
   ros::Publisher footprint_publisher_;
+  ros::ServiceServer clear_service_;
   diagnostic_updater::Updater diagnostics_;
+  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
+  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  bool reconfigure_started_ = false;
 
   ros::Timer update_timer_;
   std::mutex update_mutex_;  ///< one update at a time even on a multi-threaded queue
   std::size_t updates_skipped_busy_ = 0;
+  CellBounds unpublished_;  ///< cells redrawn since the last publish
   ros::Time last_publish_;
   ros::Time last_update_;
   RunningStats update_time_ms_;
   RunningStats update_period_s_;
   std::size_t updates_ = 0;
+  std::size_t clears_ = 0;
   std::size_t robot_pose_failures_ = 0;
   std::string last_pose_error_;
 };

@@ -43,6 +43,12 @@ class Layer {
   }
   /// The master's size, resolution or origin changed.
   virtual void matchSize() {}
+  /// Rolling window: the master's origin moved by (dx, dy) whole cells and its content moved
+  /// with it. Layers keep what stays in view; the default forgets everything (matchSize()).
+  virtual void shiftOrigin(int dx, int dy) {
+    (void)dx, (void)dy;
+    matchSize();
+  }
   /// Forget everything (clear services, move_base's clear_costmaps).
   virtual void reset() {}
   virtual void activate() {}

@@ -1,6 +1,7 @@
 // The master grid plus the ordered list of Layer plugins that draw into it.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -21,9 +22,20 @@ class LayeredCostmap {
   void addPlugin(std::shared_ptr<Layer> plugin) { plugins_.push_back(std::move(plugin)); }
   const std::vector<std::shared_ptr<Layer>>& plugins() const { return plugins_; }
 
-  /// One update: union of the enabled layers' bounds, reset of that window in the master, then
-  /// each enabled layer's updateCosts() in order. Returns the window that was redrawn.
-  CellBounds updateMap(double robot_x, double robot_y, double robot_yaw);
+  /// One update. With a rolling window and a robot pose, first re-centres the map on the robot by
+  /// whole cells (master and layers shift; that update redraws everything). Then: union of the
+  /// enabled layers' bounds, reset of that window in the master, each enabled layer's
+  /// updateCosts() in order. `have_robot_pose` false means x, y, yaw are not known (tf missing):
+  /// no shift, and layers that need the pose (footprint clearing) skip it. Returns the window
+  /// that was redrawn.
+  CellBounds updateMap(double robot_x, double robot_y, double robot_yaw,
+                       bool have_robot_pose = true);
+  /// Whether the pose passed to the current / last updateMap() was known.
+  bool hasRobotPose() const { return have_robot_pose_; }
+  /// The next updateMap() redraws the whole master (a layer was enabled or disabled, cleared).
+  void requestFullRedraw() { full_redraw_ = true; }
+  void setRollingWindow(bool rolling) { rolling_window_ = rolling; }
+  bool isRolling() const { return rolling_window_; }
   /// Resets the master and every layer.
   void resetLayers();
 
@@ -51,6 +63,9 @@ class LayeredCostmap {
   Footprint footprint_;
   double inscribed_radius_ = 0.0;
   double circumscribed_radius_ = 0.0;
+  bool rolling_window_ = false;
+  bool have_robot_pose_ = false;
+  std::atomic<bool> full_redraw_{false};
 };
 
 }  // namespace downstream_perception

@@ -116,10 +116,11 @@ CellBounds polygonCells(const Footprint& world_polygon, const GridGeometry& g,
     std::sort(crossings.begin(), crossings.end());
     for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
       // Cells whose centre x lies in [x0, x1].
-      const int c0 = std::max(
-          0, static_cast<int>(std::ceil((crossings[k] - g.originX()) / res - 0.5)));
-      const int c1 = std::min(
-          g.sizeX() - 1, static_cast<int>(std::floor((crossings[k + 1] - g.originX()) / res - 0.5)));
+      const int c0 =
+          std::max(0, static_cast<int>(std::ceil((crossings[k] - g.originX()) / res - 0.5)));
+      const int c1 =
+          std::min(g.sizeX() - 1,
+                   static_cast<int>(std::floor((crossings[k + 1] - g.originX()) / res - 0.5)));
       if (c0 > c1) continue;
       window.expand(c0, cy);
       window.expand(c1, cy);

@@ -24,10 +24,9 @@ void writeRow(const std::int16_t* in, std::uint8_t* dst, int width, int occupied
   for (int x = 0; x < width; ++x) {
     const int v = in[x];
     const std::uint8_t old = dst[x];
-    const std::uint8_t layer = v > occupied_raw
-                                   ? cost::kLethalObstacle
-                                   : (v < free_raw ? cost::kFreeSpace
-                                                   : (kWriteUnknown ? unknown_cost : old));
+    const std::uint8_t layer =
+        v > occupied_raw ? cost::kLethalObstacle
+                         : (v < free_raw ? cost::kFreeSpace : (kWriteUnknown ? unknown_cost : old));
     dst[x] = (kWriteUnknown || v > occupied_raw || v < free_raw) ? combine(old, layer) : old;
   }
 }
@@ -35,8 +34,7 @@ void writeRow(const std::int16_t* in, std::uint8_t* dst, int width, int occupied
 }  // namespace
 
 std::size_t writeStateCosts(const LogOddsGrid& grid, const CellBounds& window, bool write_unknown,
-                            std::uint8_t unknown_cost, Costmap* master,
-                            CombinationMethod method) {
+                            std::uint8_t unknown_cost, Costmap* master, CombinationMethod method) {
   if (master == nullptr || !(grid.geometry() == master->geometry())) {
     throw std::invalid_argument(
         "writeStateCosts: the master grid's geometry differs from the layer's");

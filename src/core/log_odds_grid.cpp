@@ -108,8 +108,7 @@ void LogOddsGrid::countStates(std::size_t* free_cells, std::size_t* occupied_cel
   *unknown_cells = cells_.size() - n_free - n_occ;
 }
 
-CellBounds LogOddsGrid::decay(double factor, const CellBounds& window,
-                              std::size_t* changed_cells) {
+CellBounds LogOddsGrid::decay(double factor, const CellBounds& window, std::size_t* changed_cells) {
   CellBounds changed;
   if (!(factor >= 0.0 && factor <= 1.0)) {
     throw std::invalid_argument("LogOddsGrid::decay: factor must be in [0, 1], got " +

@@ -38,6 +38,7 @@ try:
         apply,
         bresenham_line,
         compose,
+        footprint_cells,
         footprint_radii,
         inflate,
         inflation_cost,

@@ -5,38 +5,52 @@
 #include <chrono>
 #include <limits>
 
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/layered_costmap.h"
 
 namespace downstream_perception {
 
 void InflationLayer::onInitialize() {
-  nh_.param("enabled", enabled_, true);
-  const InflationConfig defaults;
-  nh_.param("inflation_radius", config_.inflation_radius, defaults.inflation_radius);
-  nh_.param("cost_scaling_factor", config_.cost_scaling_factor, defaults.cost_scaling_factor);
-  nh_.param("inflate_unknown", config_.inflate_unknown, defaults.inflate_unknown);
-  applyConfig();
+  // The server reads the YAML values (or the .cfg defaults, equal to InflationConfig's) and calls
+  // reconfigure() at once: one code path for start-up and live changes.
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
+  reconfigure_server_->setCallback(boost::bind(&InflationLayer::reconfigure, this,
+                                               boost::placeholders::_1, boost::placeholders::_2));
 }
 
-void InflationLayer::applyConfig() {
+void InflationLayer::reconfigure(InflationLayerConfig& cfg, std::uint32_t) {
+  InflationConfig candidate = config_;
+  candidate.inflation_radius = cfg.inflation_radius;
+  candidate.cost_scaling_factor = cfg.cost_scaling_factor;
+  candidate.inflate_unknown = cfg.inflate_unknown;
+  applyConfig(candidate);
+  if (cfg.enabled != enabled_) {
+    enabled_ = cfg.enabled;
+    layered_costmap_->requestFullRedraw();  // its costs appear or vanish everywhere
+  }
+}
+
+void InflationLayer::applyConfig(InflationConfig candidate) {
   std::lock_guard<std::mutex> lock(mutex_);
-  config_.inscribed_radius = layered_costmap_->inscribedRadius();
-  std::string why = config_.validate();
-  if (why.empty() && config_.inflation_radius < config_.inscribed_radius) {
+  candidate.inscribed_radius = layered_costmap_->inscribedRadius();
+  const std::string why = candidate.validate();
+  if (!why.empty()) {
+    const std::string msg = "parameters invalid (" + why + "); keeping inflation_radius " +
+                            std::to_string(config_.inflation_radius) + " m, cost_scaling_factor " +
+                            std::to_string(config_.cost_scaling_factor) + " 1/m";
+    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
+    config_errors_.push_back(msg);
+    candidate = config_;
+    candidate.inscribed_radius = layered_costmap_->inscribedRadius();
+  }
+  if (candidate.inflation_radius < candidate.inscribed_radius) {
     // Allowed (costmap_2d accepts it) but the robot would touch walls the planner thinks clear.
     ROS_WARN(
         "layer '%s': inflation_radius %.3f m is smaller than the footprint's inscribed "
         "radius %.3f m",
-        name_.c_str(), config_.inflation_radius, config_.inscribed_radius);
+        name_.c_str(), candidate.inflation_radius, candidate.inscribed_radius);
   }
-  if (!why.empty()) {
-    const std::string msg = "parameters invalid (" + why + "); using the defaults";
-    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-    config_errors_.push_back(msg);
-    const double inscribed = config_.inscribed_radius;
-    config_ = InflationConfig{};
-    config_.inscribed_radius = inscribed;
-  }
+  config_ = candidate;
   const double resolution = layered_costmap_->costmap().geometry().resolution();
   inflator_ = std::make_unique<Inflator>(config_, resolution > 0.0 ? resolution : 0.05);
   need_full_window_ = true;
@@ -50,6 +64,7 @@ void InflationLayer::applyConfig() {
 void InflationLayer::updateBounds(double, double, double, double* min_x, double* min_y,
                                   double* max_x, double* max_y) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!inflator_) return;
   if (need_full_window_) {
     const GridGeometry& g = layered_costmap_->costmap().geometry();
     CellBounds all;
@@ -70,7 +85,7 @@ void InflationLayer::updateBounds(double, double, double, double* min_x, double*
 
 void InflationLayer::updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (min_i >= max_i || min_j >= max_j) return;
+  if (!inflator_ || min_i >= max_i || min_j >= max_j) return;
   const auto t0 = std::chrono::steady_clock::now();
   CellBounds window;
   window.expand(min_i, min_j);
@@ -83,17 +98,23 @@ void InflationLayer::updateCosts(Costmap& master, int min_i, int min_j, int max_
 
 void InflationLayer::matchSize() {
   // The Inflator follows the master's geometry by itself; a new resolution needs a new table.
-  applyConfig();
+  if (inflator_) applyConfig(config_);
+}
+
+void InflationLayer::shiftOrigin(int dx, int dy) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (inflator_) inflator_->shift(dx, dy);
 }
 
 void InflationLayer::reset() {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!inflator_) return;
   inflator_->reset();
   need_full_window_ = true;
 }
 
 void InflationLayer::onFootprintChanged() {
-  if (inflator_) applyConfig();
+  if (inflator_) applyConfig(config_);
 }
 
 void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -104,7 +125,7 @@ void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "inflating");
   }
   status.add("inflation radius (m)", config_.inflation_radius);
-  status.add("inflation radius (cells)", inflator_->radiusCells());
+  status.add("inflation radius (cells)", inflator_ ? inflator_->radiusCells() : 0);
   status.add("cost scaling factor (1/m)", config_.cost_scaling_factor);
   status.add("inscribed radius (m)", config_.inscribed_radius);
   status.add("inflate unknown", config_.inflate_unknown);
@@ -114,7 +135,7 @@ void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("last update: lethal cells changed", last_.lethal_changed);
   status.add("last update: cells re-inflated", last_.cells_recomputed);
   status.add("last update: cells merged", last_.cells_merged);
-  status.add("config errors", config_errors_.size());
+  addConfigErrors(status, config_errors_);
 }
 
 }  // namespace downstream_perception

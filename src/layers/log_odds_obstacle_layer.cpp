@@ -3,38 +3,106 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <sstream>
 
-#include "downstream_perception/core/log_odds_costs.h"
+#include "downstream_perception/config_errors.h"
+#include "downstream_perception/core/footprint.h"
 #include "downstream_perception/layered_costmap.h"
+#include "downstream_perception/layers/laser_scan_source.h"
+#include "downstream_perception/layers/point_cloud_source.h"
 
 namespace downstream_perception {
 
+namespace {
+// Decay runs at most this often: each pass scans the evidence box once.
+constexpr double kMinDecayPeriodS = 0.1;
+}  // namespace
+
 LogOddsObstacleLayer::~LogOddsObstacleLayer() {
   // Stop the callbacks before the grid they write into goes away.
+  reconfigure_server_.reset();
   sources_.clear();
 }
 
+void LogOddsObstacleLayer::reportError(const std::string& msg) {
+  ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
+  std::lock_guard<std::mutex> lock(errors_mutex_);
+  config_errors_.push_back(msg);
+}
+
 void LogOddsObstacleLayer::onInitialize() {
-  nh_.param("enabled", enabled_, true);
-  const LogOddsConfig defaults;
-  nh_.param("p_hit", grid_config_.p_hit, defaults.p_hit);
-  nh_.param("p_miss", grid_config_.p_miss, defaults.p_miss);
-  nh_.param("log_odds_min", grid_config_.clamp_min, defaults.clamp_min);
-  nh_.param("log_odds_max", grid_config_.clamp_max, defaults.clamp_max);
-  nh_.param("occupied_log_odds", grid_config_.occupied_threshold, defaults.occupied_threshold);
-  nh_.param("free_log_odds", grid_config_.free_threshold, defaults.free_threshold);
   nh_.param("track_unknown_space", track_unknown_space_, layered_costmap_->isTrackingUnknown());
-  const std::string why = grid_config_.validate();
-  if (!why.empty()) {
-    const std::string msg = "sensor model invalid (" + why + "); using the defaults";
-    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-    config_errors_.push_back(msg);
-    grid_config_ = defaults;
-  }
   grid_ = LogOddsGrid(layered_costmap_->costmap().geometry(), grid_config_);
   readSources();
-  if (enabled_) activate();
+  // The server reads the YAML values (or the .cfg defaults, equal to the C++ ones) and calls
+  // reconfigure() once at once: one code path for start-up and live changes.
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
+  reconfigure_server_->setCallback(boost::bind(&LogOddsObstacleLayer::reconfigure, this,
+                                               boost::placeholders::_1, boost::placeholders::_2));
+}
+
+void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uint32_t) {
+  LogOddsConfig model;
+  model.p_hit = cfg.p_hit;
+  model.p_miss = cfg.p_miss;
+  model.clamp_min = cfg.log_odds_min;
+  model.clamp_max = cfg.log_odds_max;
+  model.occupied_threshold = cfg.occupied_log_odds;
+  model.free_threshold = cfg.free_log_odds;
+  std::string why = model.validate();
+  if (!why.empty()) {
+    reportError("sensor model invalid (" + why + "); keeping p_hit " +
+                std::to_string(grid_config_.p_hit) + ", p_miss " +
+                std::to_string(grid_config_.p_miss) + " and the previous limits");
+    model = grid_config_;
+  }
+  ObstacleLayerConfig layer = config_;
+  why = validateCombinationMethod(cfg.combination_method);
+  if (why.empty()) {
+    layer.combination_method = static_cast<CombinationMethod>(cfg.combination_method);
+  } else {
+    reportError(why + "; keeping " + std::to_string(static_cast<int>(config_.combination_method)));
+  }
+  if (std::isfinite(cfg.decay_time_s) && cfg.decay_time_s >= 0.0) {
+    layer.decay_time_s = cfg.decay_time_s;
+  } else {
+    reportError("decay_time_s must be finite and >= 0 s (0 = off), got " +
+                std::to_string(cfg.decay_time_s) + "; keeping " +
+                std::to_string(config_.decay_time_s));
+  }
+  layer.footprint_clearing_enabled = cfg.footprint_clearing_enabled;
+  {
+    std::lock_guard<std::mutex> lock(grid_mutex_);
+    grid_config_ = model;
+    if (!(grid_.config().p_hit == model.p_hit && grid_.config().p_miss == model.p_miss &&
+          grid_.config().clamp_min == model.clamp_min &&
+          grid_.config().clamp_max == model.clamp_max &&
+          grid_.config().occupied_threshold == model.occupied_threshold &&
+          grid_.config().free_threshold == model.free_threshold)) {
+      grid_.setConfig(model);  // thresholds may have moved: every state is re-read
+    }
+    config_ = layer;
+    last_decay_ = ros::Time();
+  }
+  markAllDirty();
+  const bool was_enabled = enabled_;
+  enabled_ = cfg.enabled;
+  // Subscribed exactly while enabled (activate/deactivate are idempotent).
+  if (enabled_) {
+    activate();
+  } else {
+    deactivate();
+  }
+  // The layer's cells appear or disappear from the master: redraw all of it.
+  if (was_enabled != enabled_) layered_costmap_->requestFullRedraw();
+  ROS_INFO(
+      "layer '%s': p_hit %.3f p_miss %.3f, log-odds in [%.2f, %.2f], occupied > %.2f, "
+      "free < %.2f, combination %d, footprint clearing %s, decay time %.2f s, %s",
+      name_.c_str(), model.p_hit, model.p_miss, model.clamp_min, model.clamp_max,
+      model.occupied_threshold, model.free_threshold, static_cast<int>(layer.combination_method),
+      layer.footprint_clearing_enabled ? "on" : "off", layer.decay_time_s,
+      enabled_ ? "enabled" : "disabled");
 }
 
 void LogOddsObstacleLayer::readSources() {
@@ -44,20 +112,23 @@ void LogOddsObstacleLayer::readSources() {
   std::string name;
   while (stream >> name) {
     ros::NodeHandle snh(nh_, name);
-    LaserScanSourceConfig config;
+    ObservationSourceConfig config;
     std::string data_type;
     snh.param("data_type", data_type, std::string("LaserScan"));
-    if (data_type != "LaserScan") {
-      const std::string msg = "source '" + name + "': data_type '" + data_type +
-                              "' is not supported yet (only LaserScan); source ignored";
-      ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-      config_errors_.push_back(msg);
+    if (data_type != "LaserScan" && data_type != "PointCloud2") {
+      reportError("source '" + name + "': data_type '" + data_type +
+                  "' is not supported (LaserScan or PointCloud2); source ignored");
       continue;
     }
     snh.param("topic", config.topic, name);
     snh.param("sensor_frame", config.sensor_frame, std::string());
     snh.param("expected_update_rate", config.expected_update_rate, 0.0);
     snh.param("tf_queue_size", config.tf_queue_size, 20);
+    snh.param("per_beam_time_correction", config.per_beam_time_correction, true);
+    snh.param("min_obstacle_height", config.cloud.min_obstacle_height,
+              CloudBeamsConfig{}.min_obstacle_height);
+    snh.param("max_obstacle_height", config.cloud.max_obstacle_height,
+              CloudBeamsConfig{}.max_obstacle_height);
     ScanIntegratorConfig& ic = config.integrator;
     const ScanIntegratorConfig d;
     snh.param("marking", ic.marking, d.marking);
@@ -69,51 +140,98 @@ void LogOddsObstacleLayer::readSources() {
     snh.param("inf_is_valid", ic.inf_is_valid, d.inf_is_valid);
     snh.param("range_max_is_no_return", ic.range_max_is_no_return, d.range_max_is_no_return);
     std::string why = ic.validate();
+    if (why.empty()) why = config.cloud.validate();
     if (config.tf_queue_size < 1 || config.tf_queue_size > 10000) {
       why = "tf_queue_size must be in [1, 10000], got " + std::to_string(config.tf_queue_size);
     }
     if (!why.empty()) {
-      const std::string msg = "source '" + name + "': " + why + "; source ignored";
-      ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-      config_errors_.push_back(msg);
+      reportError("source '" + name + "': " + why + "; source ignored");
       continue;
     }
-    sources_.push_back(std::make_unique<LaserScanSource>(
-        name, config, nh_, *tf_, layered_costmap_->globalFrame(),
-        [this](LaserScanSource& source, const AcceptedScan& scan) {
-          integrateScan(source, scan);
-        }));
-    ROS_INFO("layer '%s': source '%s' on %s (mark <= %.2f m, clear <= %.2f m, inf_is_valid %s)",
-             name_.c_str(), name.c_str(),
+    auto on_observation = [this](ObservationSource& source, const Observation& observation) {
+      integrate(source, observation);
+    };
+    if (data_type == "LaserScan") {
+      sources_.push_back(std::make_unique<LaserScanSource>(
+          name, config, nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
+    } else {
+      sources_.push_back(std::make_unique<PointCloudSource>(
+          name, config, nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
+    }
+    ROS_INFO("layer '%s': %s source '%s' on %s (mark <= %.2f m, clear <= %.2f m%s)", name_.c_str(),
+             data_type.c_str(), name.c_str(),
              ros::names::resolve(nh_.getNamespace(), config.topic).c_str(), ic.obstacle_max_range,
-             ic.raytrace_max_range, ic.inf_is_valid ? "true" : "false");
+             ic.raytrace_max_range,
+             data_type == "PointCloud2"
+                 ? (", heights [" + std::to_string(config.cloud.min_obstacle_height) + ", " +
+                    std::to_string(config.cloud.max_obstacle_height) + "] m")
+                       .c_str()
+                 : "");
   }
   if (sources_.empty()) {
     ROS_WARN("layer '%s': no usable observation_sources; the layer will stay empty", name_.c_str());
   }
 }
 
-void LogOddsObstacleLayer::integrateScan(LaserScanSource& source, const AcceptedScan& scan) {
+void LogOddsObstacleLayer::integrate(ObservationSource& source, const Observation& observation) {
   const auto t0 = std::chrono::steady_clock::now();
   IntegrationStats stats;
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
-    stats = source.integrator().integrate(grid_, scan.view, scan.sensor_pose);
+    stats = source.integrator().integrate(grid_, observation.beams, observation.decisions);
     // Only cells whose state changed alter this layer's output: that is the window the master
     // must refresh (a sensor sweeping an unchanged room costs no re-inflation downstream).
     dirty_.expand(stats.changed);
+    evidence_box_.expand(stats.touched);
   }
   const auto t1 = std::chrono::steady_clock::now();
-  const double age = (ros::Time::now() - scan.msg->header.stamp).toSec();
+  const double age = (ros::Time::now() - observation.stamp).toSec();
   source.recordIntegration(stats, std::chrono::duration<double, std::milli>(t1 - t0).count(), age);
 }
 
-void LogOddsObstacleLayer::updateBounds(double, double, double, double* min_x, double* min_y,
-                                        double* max_x, double* max_y) {
+void LogOddsObstacleLayer::clearFootprint(double robot_x, double robot_y, double robot_yaw) {
+  // The robot stands there: whatever a sensor saw in its footprint (its own body, a stale
+  // obstacle) is free. Caller holds grid_mutex_.
+  footprint_scratch_.clear();
+  const Footprint world =
+      transformFootprint(layered_costmap_->footprint(), Pose2D{robot_x, robot_y, robot_yaw});
+  polygonCells(world, grid_.geometry(), &footprint_scratch_);
+  for (const std::size_t i : footprint_scratch_) {
+    if (grid_.state(i) == CellState::kFree) continue;
+    grid_.setLogOdds(i, grid_config_.clamp_min);
+    const CellIndex c = grid_.geometry().cellOf(i);
+    dirty_.expand(c.x, c.y);
+    evidence_box_.expand(c.x, c.y);
+    ++footprint_cells_cleared_;
+  }
+}
+
+void LogOddsObstacleLayer::decay() {
+  // Caller holds grid_mutex_.
+  const ros::Time now = ros::Time::now();
+  if (last_decay_.isZero() || now < last_decay_) {
+    last_decay_ = now;
+    return;
+  }
+  const double dt = (now - last_decay_).toSec();
+  if (dt < kMinDecayPeriodS) return;
+  last_decay_ = now;
+  std::size_t changed = 0;
+  dirty_.expand(grid_.decay(std::exp(-dt / config_.decay_time_s), evidence_box_, &changed));
+  cells_decayed_to_unknown_ += changed;
+}
+
+void LogOddsObstacleLayer::updateBounds(double robot_x, double robot_y, double robot_yaw,
+                                        double* min_x, double* min_y, double* max_x,
+                                        double* max_y) {
   bool current = true;
   for (const auto& source : sources_) current = current && source->isCurrent();
   current_ = current;
   std::lock_guard<std::mutex> lock(grid_mutex_);
+  if (config_.decay_time_s > 0.0) decay();
+  if (config_.footprint_clearing_enabled && layered_costmap_->hasRobotPose()) {
+    clearFootprint(robot_x, robot_y, robot_yaw);
+  }
   grid_.geometry().expandWorldBox(dirty_, min_x, min_y, max_x, max_y);
   dirty_ = CellBounds{};
 }
@@ -127,25 +245,48 @@ void LogOddsObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, in
   window.expand(max_i - 1, max_j - 1);
   // Unknown cells write nothing when tracking unknown space: costmap_2d's updateWithOverwrite
   // never writes NO_INFORMATION over what the master holds.
-  writeStateCosts(grid_, window, !track_unknown_space_, cost::kFreeSpace, &master);
+  writeStateCosts(grid_, window, !track_unknown_space_, cost::kFreeSpace, &master,
+                  config_.combination_method);
 }
 
-void LogOddsObstacleLayer::matchSize() {
+void LogOddsObstacleLayer::markAllDirty() {
   std::lock_guard<std::mutex> lock(grid_mutex_);
-  const GridGeometry& g = layered_costmap_->costmap().geometry();
-  if (grid_.geometry() != g) grid_.resize(g);
-  dirty_ = CellBounds{};
-  dirty_.expand(0, 0);
-  dirty_.expand(g.sizeX() - 1, g.sizeY() - 1);
-}
-
-void LogOddsObstacleLayer::reset() {
-  std::lock_guard<std::mutex> lock(grid_mutex_);
-  grid_.reset();
   const GridGeometry& g = grid_.geometry();
   dirty_ = CellBounds{};
   dirty_.expand(0, 0);
   dirty_.expand(g.sizeX() - 1, g.sizeY() - 1);
+}
+
+void LogOddsObstacleLayer::matchSize() {
+  {
+    std::lock_guard<std::mutex> lock(grid_mutex_);
+    const GridGeometry& g = layered_costmap_->costmap().geometry();
+    if (grid_.geometry() != g) grid_.resize(g);
+    evidence_box_ = CellBounds{};
+  }
+  markAllDirty();
+}
+
+void LogOddsObstacleLayer::shiftOrigin(int dx, int dy) {
+  std::lock_guard<std::mutex> lock(grid_mutex_);
+  grid_.shift(dx, dy);
+  // Windows move with the content; the host redraws the whole master after a shift.
+  for (CellBounds* b : {&dirty_, &evidence_box_}) {
+    if (b->empty()) continue;
+    b->min_x -= dx;
+    b->max_x -= dx;
+    b->min_y -= dy;
+    b->max_y -= dy;
+  }
+}
+
+void LogOddsObstacleLayer::reset() {
+  {
+    std::lock_guard<std::mutex> lock(grid_mutex_);
+    grid_.reset();
+    evidence_box_ = CellBounds{};
+  }
+  markAllDirty();
 }
 
 void LogOddsObstacleLayer::activate() {
@@ -161,10 +302,16 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   std::size_t n_occ = 0;
   std::size_t n_unknown = 0;
   double max_abs = 0.0;
+  std::size_t decayed = 0;
+  std::size_t footprint_cleared = 0;
+  ObstacleLayerConfig config;
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
     grid_.countStates(&n_free, &n_occ, &n_unknown);
     max_abs = grid_.maxAbsLogOdds();
+    decayed = cells_decayed_to_unknown_;
+    footprint_cleared = footprint_cells_cleared_;
+    config = config_;
   }
   std::size_t rejected_total = 0;
   bool all_current = true;
@@ -176,25 +323,28 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     const auto& h = source->health();
     const std::string p = source->name() + ": ";
     any_integrated = any_integrated || h.integrated > 0;
-    status.add(p + "scans received", h.received);
-    status.add(p + "scans integrated", h.integrated);
+    status.add(p + "data type", source->dataType());
+    status.add(p + "messages received", h.received);
+    status.add(p + "messages integrated", h.integrated);
     std::size_t rejected = 0;
     for (const auto& [reason, count] : h.rejected) {
       status.add(p + "rejected (" + reason + ")", count);
       rejected += count;
     }
+    for (const auto& [what, count] : h.notes) status.add(p + what, count);
     rejected_total += rejected;
-    status.add(p + "scans rejected", rejected);
+    status.add(p + "messages rejected", rejected);
     status.add(p + "transform age at integration mean (s)", h.transform_age_s.mean());
     status.add(p + "transform age at integration max (s)", h.transform_age_s.max);
     status.add(p + "integration time mean (ms)", h.integrate_ms.mean());
     status.add(p + "integration time max (ms)", h.integrate_ms.max);
-    status.add(p + "last scan cells cleared", h.last.cells_cleared);
-    status.add(p + "last scan cells marked", h.last.cells_marked);
-    status.add(p + "clear:mark ratio (last scan)", h.last.clearMarkRatio());
-    status.add(p + "clear:mark ratio (all scans)", h.total.clearMarkRatio());
+    status.add(p + "last message cells cleared", h.last.cells_cleared);
+    status.add(p + "last message cells marked", h.last.cells_marked);
+    status.add(p + "clear:mark ratio (last message)", h.last.clearMarkRatio());
+    status.add(p + "clear:mark ratio (all messages)", h.total.clearMarkRatio());
     status.add(p + "beams invalid (total)", h.total.beams_invalid);
     status.add(p + "beams no return (total)", h.total.beams_no_return);
+    status.add(p + "points outside height band (total)", h.total.points_outside_height);
     status.add(p + "current", current);
   }
   status.add("cells occupied", n_occ);
@@ -202,17 +352,27 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   status.add("cells unknown", n_unknown);
   status.add("max |log-odds|", max_abs);
   status.add("log-odds clamp", grid_config_.clamp_max);
+  status.add("combination method", static_cast<int>(config.combination_method));
+  status.add("footprint clearing", config.footprint_clearing_enabled);
+  status.add("footprint cells cleared (total)", footprint_cleared);
+  status.add("decay time (s)", config.decay_time_s);
+  status.add("cells decayed to another state (total)", decayed);
   status.add("memory (bytes)", grid_.memoryBytes());
-  status.add("config errors", config_errors_.size());
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  std::vector<std::string> errors;
+  {
+    std::lock_guard<std::mutex> lock(errors_mutex_);
+    errors = config_errors_;
+  }
+  addConfigErrors(status, errors);
+  if (!errors.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, errors.front());
   } else if (!all_current) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "a source is not current");
   } else if (!any_integrated) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no scan integrated yet");
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no message integrated yet");
   } else if (rejected_total > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   std::to_string(rejected_total) + " scan(s) rejected (see counts)");
+                   std::to_string(rejected_total) + " message(s) rejected (see counts)");
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "integrating");
   }

@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 
+#include "downstream_perception/core/cloud_beams.h"
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/core/footprint.h"
 #include "downstream_perception/core/grid_geometry.h"
@@ -176,6 +177,19 @@ PYBIND11_MODULE(_core, m) {
            })
       .def("reset", &LogOddsGrid::reset)
       .def("shift", &LogOddsGrid::shift, py::arg("dx"), py::arg("dy"))
+      .def(
+          "decay",
+          [](LogOddsGrid& self, double factor) {
+            CellBounds all;
+            all.expand(0, 0);
+            all.expand(self.geometry().sizeX() - 1, self.geometry().sizeY() - 1);
+            std::size_t changed = 0;
+            self.decay(factor, all, &changed);
+            return changed;
+          },
+          py::arg("factor"),
+          "Every cell's log-odds times factor in [0, 1] (exp(-dt / tau)), rounded toward zero. "
+          "Returns how many cells changed state.")
       .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds)
       .def_property_readonly("memory_bytes", &LogOddsGrid::memoryBytes);
 
@@ -204,6 +218,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("cells_cleared", &IntegrationStats::cells_cleared)
       .def_readonly("cells_marked", &IntegrationStats::cells_marked)
       .def_readonly("cells_changed", &IntegrationStats::cells_changed)
+      .def_readonly("points_outside_height", &IntegrationStats::points_outside_height)
       .def_property_readonly(
           "touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
           "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
@@ -231,7 +246,65 @@ PYBIND11_MODULE(_core, m) {
           py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
           py::arg("range_min"), py::arg("range_max"), py::arg("sensor_pose"),
           "Integrates one LaserScan (REP-117 semantics) taken at sensor_pose = (x, y, yaw) in the "
-          "grid frame. Raises ValueError for a malformed scan header.");
+          "grid frame. Raises ValueError for a malformed scan header.")
+      .def(
+          "integrate_moving",
+          [](ScanIntegrator& self, LogOddsGrid& grid,
+             py::array_t<float, py::array::c_style | py::array::forcecast> ranges, double angle_min,
+             double angle_increment, double range_min, double range_max,
+             std::tuple<double, double, double> first, std::tuple<double, double, double> last) {
+            if (ranges.ndim() != 1) throw std::invalid_argument("ranges must be 1-D");
+            LaserScanView view{ranges.data(), static_cast<std::size_t>(ranges.shape(0)),
+                               angle_min,     angle_increment,
+                               range_min,     range_max};
+            const std::string why = view.validate();
+            if (!why.empty()) throw std::invalid_argument(why);
+            const Pose2D a{std::get<0>(first), std::get<1>(first), std::get<2>(first)};
+            const Pose2D b{std::get<0>(last), std::get<1>(last), std::get<2>(last)};
+            py::gil_scoped_release release;
+            std::vector<BeamUpdate> beams;
+            IntegrationStats decisions;
+            self.beamsFromMovingScan(view, a, b, &beams, &decisions);
+            return self.integrate(grid, beams, decisions);
+          },
+          py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
+          py::arg("range_min"), py::arg("range_max"), py::arg("first_beam_pose"),
+          py::arg("last_beam_pose"),
+          "Like integrate(), for a scan swept while the sensor moved: each beam is cast from the "
+          "pose interpolated between the first and the last beam's pose (per-beam correction).")
+      .def(
+          "integrate_cloud",
+          [](ScanIntegrator& self, LogOddsGrid& grid,
+             py::array_t<float, py::array::c_style | py::array::forcecast> points,
+             py::array_t<double, py::array::c_style | py::array::forcecast> grid_from_sensor,
+             double min_obstacle_height, double max_obstacle_height) {
+            if (points.ndim() != 2 || points.shape(1) != 3) {
+              throw std::invalid_argument("points must be an (N, 3) array");
+            }
+            if (grid_from_sensor.ndim() != 2 || grid_from_sensor.shape(0) != 4 ||
+                grid_from_sensor.shape(1) != 4) {
+              throw std::invalid_argument("grid_from_sensor must be a 4 x 4 matrix");
+            }
+            const CloudBeamsConfig config{min_obstacle_height, max_obstacle_height};
+            const std::string why = config.validate();
+            if (!why.empty()) throw std::invalid_argument(why);
+            Eigen::Matrix4d m;
+            for (int r = 0; r < 4; ++r) {
+              for (int c = 0; c < 4; ++c) m(r, c) = grid_from_sensor.at(r, c);
+            }
+            Eigen::Isometry3d pose(m);
+            py::gil_scoped_release release;
+            std::vector<BeamUpdate> beams;
+            IntegrationStats decisions;
+            beamsFromCloud(self, config, reinterpret_cast<const unsigned char*>(points.data()),
+                           static_cast<std::size_t>(points.shape(0)), 3 * sizeof(float), pose,
+                           &beams, &decisions);
+            return self.integrate(grid, beams, decisions);
+          },
+          py::arg("grid"), py::arg("points"), py::arg("grid_from_sensor"),
+          py::arg("min_obstacle_height") = 0.0, py::arg("max_obstacle_height") = 2.0,
+          "Integrates an (N, 3) point cloud in the sensor frame placed by the 4 x 4 transform "
+          "grid_from_sensor; points outside the height band (grid frame z, m) are skipped.");
 
   // ----------------------------------------------------------------- SE(2)
   py::class_<Pose2D>(m, "Pose2D")
@@ -324,4 +397,25 @@ PYBIND11_MODULE(_core, m) {
         return std::make_pair(inscribedRadius(polygon), circumscribedRadius(polygon));
       },
       py::arg("points"), "(inscribed, circumscribed) radius of a footprint polygon, m.");
+  m.def(
+      "footprint_cells",
+      [](const std::vector<std::pair<double, double>>& points,
+         std::tuple<double, double, double> pose, const GridGeometry& geometry) {
+        Footprint polygon;
+        for (const auto& [x, y] : points) polygon.push_back({x, y});
+        const std::string why = validateFootprint(polygon);
+        if (!why.empty()) throw std::invalid_argument(why);
+        std::vector<std::size_t> cells;
+        polygonCells(transformFootprint(
+                         polygon, Pose2D{std::get<0>(pose), std::get<1>(pose), std::get<2>(pose)}),
+                     geometry, &cells);
+        py::array_t<bool> mask({geometry.sizeY(), geometry.sizeX()});
+        bool* m = mask.mutable_data();
+        std::fill(m, m + geometry.cellCount(), false);
+        for (const std::size_t i : cells) m[i] = true;
+        return mask;
+      },
+      py::arg("points"), py::arg("pose"), py::arg("geometry"),
+      "[y, x] bool mask of the cells whose centre lies inside the footprint placed at pose = "
+      "(x, y, yaw): the cells the obstacle layer clears under the robot.");
 }

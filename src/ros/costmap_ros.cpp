@@ -1,13 +1,13 @@
 #include "downstream_perception/costmap_ros.h"
 
 #include <geometry_msgs/PolygonStamped.h>
-
-#include "downstream_perception/footprint_params.h"
-
 #include <tf2/utils.h>
 
 #include <chrono>
 #include <sstream>
+
+#include "downstream_perception/config_errors.h"
+#include "downstream_perception/footprint_params.h"
 
 namespace downstream_perception {
 
@@ -23,46 +23,58 @@ std::string str(const T& v) {
 CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     // Named after this costmap, not the process: several nodelets share one manager.
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
-  readConfig();
+  config_ = readCostmapConfig(pnh_, &config_errors_);
   tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
   plugin_loader_ = std::make_unique<pluginlib::ClassLoader<Layer>>("downstream_perception",
                                                                    "downstream_perception::Layer");
   layered_costmap_ =
       std::make_unique<LayeredCostmap>(config_.global_frame, config_.track_unknown_space);
-
-  const int size_x = static_cast<int>(std::lround(config_.width / config_.resolution));
-  const int size_y = static_cast<int>(std::lround(config_.height / config_.resolution));
-  layered_costmap_->resizeMap(
-      GridGeometry(size_x, size_y, config_.resolution, config_.origin_x, config_.origin_y));
-
-  layered_costmap_->setFootprint(readFootprint(pnh_, &config_errors_));
+  layered_costmap_->setRollingWindow(config_.rolling_window);
+  layered_costmap_->resizeMap(GridGeometry(config_.sizeXCells(), config_.sizeYCells(),
+                                           config_.resolution, config_.origin_x, config_.origin_y));
+  footprint_publisher_ = pnh_.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
+  applyFootprint();
 
   diagnostics_.setHardwareID("costmap " + config_.global_frame);
   diagnostics_.add("costmap", this, &CostmapRos::diagnoseCostmap);
   loadPlugins();
 
-  publisher_ = std::make_unique<CostmapPublisher>(pnh_, "costmap", config_.global_frame);
-  publishFootprint();
+  publisher_ = std::make_unique<CostmapPublisher>(pnh_, "costmap", config_.global_frame,
+                                                  config_.always_send_full_costmap);
+  clear_service_ = pnh_.advertiseService("clear", &CostmapRos::clearService, this);
   update_timer_ = nh_.createTimer(ros::Duration(1.0 / config_.update_frequency),
                                   &CostmapRos::updateTimerCallback, this);
+  // Last: its first callback applies the YAML values again (a no-op) and from then on every
+  // live change goes through reconfigure().
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
+  reconfigure_server_->setCallback(boost::bind(&CostmapRos::reconfigure, this,
+                                               boost::placeholders::_1, boost::placeholders::_2));
   ROS_INFO(
-      "costmap: %d x %d cells at %.3f m in '%s', origin (%.2f, %.2f), %zu layer(s), "
+      "costmap: %d x %d cells at %.3f m in '%s', origin (%.2f, %.2f)%s, %zu layer(s), "
       "update %.1f Hz, publish %.1f Hz",
-      size_x, size_y, config_.resolution, config_.global_frame.c_str(), config_.origin_x,
-      config_.origin_y, layered_costmap_->plugins().size(), config_.update_frequency,
-      config_.publish_frequency);
+      config_.sizeXCells(), config_.sizeYCells(), config_.resolution, config_.global_frame.c_str(),
+      config_.origin_x, config_.origin_y, config_.rolling_window ? " rolling with the robot" : "",
+      layered_costmap_->plugins().size(), config_.update_frequency, config_.publish_frequency);
 }
 
 CostmapRos::~CostmapRos() {
+  reconfigure_server_.reset();
   update_timer_.stop();
   // Layers hold subscriptions that call back into them: drop them before the loader goes.
   layered_costmap_.reset();
 }
 
-void CostmapRos::publishFootprint() {
+void CostmapRos::reportError(const std::string& msg) {
+  std::lock_guard<std::mutex> lock(errors_mutex_);
+  config_errors_.push_back(msg);
+}
+
+void CostmapRos::applyFootprint() {
+  std::vector<std::string> errors;
+  layered_costmap_->setFootprint(readFootprint(pnh_, &errors));
+  for (const auto& e : errors) reportError(e);
   // Latched, in the robot frame: rviz draws it wherever the robot is.
-  footprint_publisher_ = pnh_.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
   geometry_msgs::PolygonStamped msg;
   msg.header.frame_id = config_.robot_base_frame;
   msg.header.stamp = ros::Time::now();
@@ -75,60 +87,61 @@ void CostmapRos::publishFootprint() {
   footprint_publisher_.publish(msg);
 }
 
-void CostmapRos::readConfig() {
-  const CostmapRosConfig defaults;
-  pnh_.param("global_frame", config_.global_frame, defaults.global_frame);
-  pnh_.param("robot_base_frame", config_.robot_base_frame, defaults.robot_base_frame);
-  pnh_.param("update_frequency", config_.update_frequency, defaults.update_frequency);
-  pnh_.param("publish_frequency", config_.publish_frequency, defaults.publish_frequency);
-  pnh_.param("width", config_.width, defaults.width);
-  pnh_.param("height", config_.height, defaults.height);
-  pnh_.param("resolution", config_.resolution, defaults.resolution);
-  pnh_.param("origin_x", config_.origin_x, defaults.origin_x);
-  pnh_.param("origin_y", config_.origin_y, defaults.origin_y);
-  pnh_.param("transform_tolerance", config_.transform_tolerance, defaults.transform_tolerance);
-  pnh_.param("track_unknown_space", config_.track_unknown_space, defaults.track_unknown_space);
+void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
+  if (!reconfigure_started_) {
+    // The first call carries the parameter server's values, already read (and reported if
+    // invalid) by readCostmapConfig(): nothing to apply.
+    reconfigure_started_ = true;
+    return;
+  }
+  CostmapRosConfig next = config_;
+  next.update_frequency = cfg.update_frequency;
+  next.publish_frequency = cfg.publish_frequency;
+  next.transform_tolerance = cfg.transform_tolerance;
+  next.width = cfg.width;
+  next.height = cfg.height;
+  next.resolution = cfg.resolution;
+  if (!config_.rolling_window) {
+    next.origin_x = cfg.origin_x;
+    next.origin_y = cfg.origin_y;
+  }
+  next.always_send_full_costmap = cfg.always_send_full_costmap;
+  std::vector<std::string> errors;
+  validateCostmapConfig(&next, config_, &errors);
+  for (const auto& e : errors) reportError(e);
 
-  // Absurd values: say which parameter and what we use instead, keep running.
-  const auto reject = [this](const std::string& name, const std::string& value,
-                             const std::string& fallback) {
-    const std::string msg = "parameter ~" + name + " = " + value + " is invalid; using " + fallback;
-    ROS_ERROR("costmap: %s", msg.c_str());
-    config_errors_.push_back(msg);
-  };
-  if (!std::isfinite(config_.update_frequency) || config_.update_frequency <= 0.0 ||
-      config_.update_frequency > 1000.0) {
-    reject("update_frequency", str(config_.update_frequency), str(defaults.update_frequency));
-    config_.update_frequency = defaults.update_frequency;
+  std::lock_guard<std::mutex> busy(update_mutex_);  // no update while the map changes
+  const bool resize = next.sizeXCells() != config_.sizeXCells() ||
+                      next.sizeYCells() != config_.sizeYCells() ||
+                      next.resolution != config_.resolution || next.origin_x != config_.origin_x ||
+                      next.origin_y != config_.origin_y;
+  if (resize) {
+    std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
+    // A rolling window keeps its current (robot-centred) origin; the next update re-centres.
+    const GridGeometry& g = layered_costmap_->costmap().geometry();
+    const double ox = next.rolling_window ? g.originX() : next.origin_x;
+    const double oy = next.rolling_window ? g.originY() : next.origin_y;
+    layered_costmap_->resizeMap(
+        GridGeometry(next.sizeXCells(), next.sizeYCells(), next.resolution, ox, oy));
+    ROS_INFO("costmap: resized to %d x %d cells at %.3f m", next.sizeXCells(), next.sizeYCells(),
+             next.resolution);
   }
-  if (!std::isfinite(config_.publish_frequency) || config_.publish_frequency < 0.0) {
-    reject("publish_frequency", str(config_.publish_frequency), str(defaults.publish_frequency));
-    config_.publish_frequency = defaults.publish_frequency;
+  if (next.update_frequency != config_.update_frequency) {
+    update_timer_.setPeriod(ros::Duration(1.0 / next.update_frequency));
   }
-  if (!std::isfinite(config_.transform_tolerance) || config_.transform_tolerance <= 0.0) {
-    reject("transform_tolerance", str(config_.transform_tolerance),
-           str(defaults.transform_tolerance));
-    config_.transform_tolerance = defaults.transform_tolerance;
-  }
-  const auto cells = [](double metres, double res) {
-    return static_cast<int>(std::lround(std::min(metres / res, 1e9)));
-  };
-  const std::string why =
-      (std::isfinite(config_.width) && std::isfinite(config_.height) && config_.resolution > 0.0)
-          ? GridGeometry::validate(cells(config_.width, config_.resolution),
-                                   cells(config_.height, config_.resolution), config_.resolution,
-                                   config_.origin_x, config_.origin_y)
-          : std::string("width/height/resolution must be finite and positive");
-  if (!why.empty()) {
-    reject("width/height/resolution/origin",
-           str(config_.width) + " x " + str(config_.height) + " m at " + str(config_.resolution) +
-               " m (" + why + ")",
-           "the defaults");
-    config_.width = defaults.width;
-    config_.height = defaults.height;
-    config_.resolution = defaults.resolution;
-    config_.origin_x = defaults.origin_x;
-    config_.origin_y = defaults.origin_y;
+  if (publisher_) publisher_->setAlwaysSendFull(next.always_send_full_costmap);
+  config_ = next;
+  // The footprint parameters are read back from the parameter server, so set them first.
+  double radius = 0.0;
+  double padding = 0.0;
+  pnh_.param("robot_radius", radius, cfg.robot_radius);
+  pnh_.param("footprint_padding", padding, cfg.footprint_padding);
+  if (radius != cfg.robot_radius || padding != cfg.footprint_padding) {
+    pnh_.setParam("robot_radius", cfg.robot_radius);
+    pnh_.setParam("footprint_padding", cfg.footprint_padding);
+    std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
+    applyFootprint();
+    layered_costmap_->requestFullRedraw();
   }
 }
 
@@ -141,7 +154,7 @@ void CostmapRos::loadPlugins() {
   if (plugins.getType() != XmlRpc::XmlRpcValue::TypeArray) {
     const std::string msg = "~plugins must be a list of {name, type}";
     ROS_ERROR("costmap: %s", msg.c_str());
-    config_errors_.push_back(msg);
+    reportError(msg);
     return;
   }
   for (int k = 0; k < plugins.size(); ++k) {
@@ -151,7 +164,7 @@ void CostmapRos::loadPlugins() {
         entry["type"].getType() != XmlRpc::XmlRpcValue::TypeString) {
       const std::string msg = "~plugins[" + std::to_string(k) + "] needs string 'name' and 'type'";
       ROS_ERROR("costmap: %s", msg.c_str());
-      config_errors_.push_back(msg);
+      reportError(msg);
       continue;
     }
     const std::string name = static_cast<std::string>(entry["name"]);
@@ -169,9 +182,17 @@ void CostmapRos::loadPlugins() {
       const std::string msg =
           "cannot load layer '" + name + "' of type '" + type + "': " + e.what();
       ROS_ERROR("costmap: %s", msg.c_str());
-      config_errors_.push_back(msg);
+      reportError(msg);
     }
   }
+}
+
+bool CostmapRos::clearService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
+  layered_costmap_->resetLayers();
+  ++clears_;
+  ROS_INFO("costmap: cleared every layer (~clear)");
+  return true;
 }
 
 bool CostmapRos::robotPose(double* x, double* y, double* yaw) {
@@ -204,14 +225,17 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
   double x = 0.0;
   double y = 0.0;
   double yaw = 0.0;
-  if (!robotPose(&x, &y, &yaw)) {
+  const bool have_pose = robotPose(&x, &y, &yaw);
+  if (!have_pose) {
     ++robot_pose_failures_;
-    ROS_WARN_THROTTLE(5.0, "costmap: no robot pose %s <- %s: %s (updating without it)",
+    ROS_WARN_THROTTLE(5.0,
+                      "costmap: no robot pose %s <- %s: %s (updating without it: no footprint "
+                      "clearing, no rolling)",
                       config_.global_frame.c_str(), config_.robot_base_frame.c_str(),
                       last_pose_error_.c_str());
   }
   const auto t0 = std::chrono::steady_clock::now();
-  layered_costmap_->updateMap(x, y, yaw);
+  unpublished_.expand(layered_costmap_->updateMap(x, y, yaw, have_pose));
   const auto t1 = std::chrono::steady_clock::now();
   update_time_ms_.add(std::chrono::duration<double, std::milli>(t1 - t0).count());
   if (!last_update_.isZero()) update_period_s_.add((event.current_real - last_update_).toSec());
@@ -223,7 +247,8 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
       (last_publish_.isZero() ||
        (now - last_publish_).toSec() >= 1.0 / config_.publish_frequency)) {
     std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
-    publisher_->publish(layered_costmap_->costmap(), now);
+    publisher_->publish(layered_costmap_->costmap(), now, unpublished_);
+    unpublished_ = CellBounds{};
     last_publish_ = now;
   }
   diagnostics_.update();
@@ -231,8 +256,13 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
 
 void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status) {
   const double achieved_hz = update_period_s_.mean() > 0.0 ? 1.0 / update_period_s_.mean() : 0.0;
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  std::vector<std::string> errors;
+  {
+    std::lock_guard<std::mutex> lock(errors_mutex_);
+    errors = config_errors_;
+  }
+  if (!errors.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, errors.front());
   } else if (!layered_costmap_->isCurrent()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "a layer is not current");
   } else if (updates_ > 10 && achieved_hz < 0.8 * config_.update_frequency) {
@@ -243,6 +273,8 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   const GridGeometry& g = layered_costmap_->costmap().geometry();
   status.add("size (cells)", str(g.sizeX()) + " x " + str(g.sizeY()));
   status.add("resolution (m)", g.resolution());
+  status.add("origin (m)", str(g.originX()) + ", " + str(g.originY()));
+  status.add("rolling window", config_.rolling_window);
   status.add("updates", updates_);
   status.add("update rate requested (Hz)", config_.update_frequency);
   status.add("update rate achieved (Hz)", achieved_hz);
@@ -252,7 +284,10 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("updates skipped (previous still running)", updates_skipped_busy_);
   status.add("robot pose failures", robot_pose_failures_);
   if (!last_pose_error_.empty()) status.add("last robot pose error", last_pose_error_);
-  status.add("config errors", config_errors_.size());
+  status.add("full grids published", publisher_ ? publisher_->fullGridsPublished() : 0);
+  status.add("updates published", publisher_ ? publisher_->updatesPublished() : 0);
+  status.add("clears (~clear)", clears_);
+  addConfigErrors(status, errors);
   status.add("footprint inscribed radius (m)", layered_costmap_->inscribedRadius());
   status.add("footprint circumscribed radius (m)", layered_costmap_->circumscribedRadius());
 }

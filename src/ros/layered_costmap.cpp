@@ -1,5 +1,6 @@
 #include "downstream_perception/layered_costmap.h"
 
+#include <cmath>
 #include <limits>
 
 namespace downstream_perception {
@@ -13,10 +14,26 @@ void LayeredCostmap::resizeMap(const GridGeometry& geometry) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   master_.resize(geometry);
   for (auto& plugin : plugins_) plugin->matchSize();
+  full_redraw_ = true;
 }
 
-CellBounds LayeredCostmap::updateMap(double robot_x, double robot_y, double robot_yaw) {
+CellBounds LayeredCostmap::updateMap(double robot_x, double robot_y, double robot_yaw,
+                                     bool have_robot_pose) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
+  have_robot_pose_ = have_robot_pose;
+  if (rolling_window_ && have_robot_pose) {
+    // Robot-centred, snapped to whole cells so that cell contents never get resampled.
+    const GridGeometry& g = master_.geometry();
+    const int dx = static_cast<int>(
+        std::lround((robot_x - 0.5 * g.sizeXMetres() - g.originX()) / g.resolution()));
+    const int dy = static_cast<int>(
+        std::lround((robot_y - 0.5 * g.sizeYMetres() - g.originY()) / g.resolution()));
+    if (dx != 0 || dy != 0) {
+      master_.shift(dx, dy);
+      for (auto& plugin : plugins_) plugin->shiftOrigin(dx, dy);
+      full_redraw_ = true;
+    }
+  }
   double min_x = std::numeric_limits<double>::max();
   double min_y = std::numeric_limits<double>::max();
   double max_x = std::numeric_limits<double>::lowest();
@@ -25,7 +42,12 @@ CellBounds LayeredCostmap::updateMap(double robot_x, double robot_y, double robo
     if (!plugin->isEnabled()) continue;
     plugin->updateBounds(robot_x, robot_y, robot_yaw, &min_x, &min_y, &max_x, &max_y);
   }
-  const CellBounds window = master_.geometry().worldBoxToCells(min_x, min_y, max_x, max_y);
+  CellBounds window = master_.geometry().worldBoxToCells(min_x, min_y, max_x, max_y);
+  if (full_redraw_.exchange(false)) {
+    window = CellBounds{};
+    window.expand(0, 0);
+    window.expand(master_.geometry().sizeX() - 1, master_.geometry().sizeY() - 1);
+  }
   if (window.empty()) return window;
   master_.resetWindow(window);
   for (auto& plugin : plugins_) {
@@ -39,6 +61,7 @@ void LayeredCostmap::resetLayers() {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   master_.reset();
   for (auto& plugin : plugins_) plugin->reset();
+  full_redraw_ = true;
 }
 
 bool LayeredCostmap::isCurrent() const {

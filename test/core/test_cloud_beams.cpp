@@ -36,8 +36,8 @@ TEST(CloudBeams, HeightBandOriginAndInvalidPoints) {
   };
   std::vector<BeamUpdate> beams;
   IntegrationStats stats;
-  beamsFromCloud(integrator, cc, reinterpret_cast<const unsigned char*>(&cloud[0].x),
-                 cloud.size(), sizeof(PointXYZI), pose, &beams, &stats);
+  beamsFromCloud(integrator, cc, reinterpret_cast<const unsigned char*>(&cloud[0].x), cloud.size(),
+                 sizeof(PointXYZI), pose, &beams, &stats);
   ASSERT_EQ(beams.size(), 2u);
   EXPECT_EQ(stats.points_outside_height, 2u);
   EXPECT_EQ(stats.beams_invalid, 2u);
@@ -64,8 +64,9 @@ TEST(CloudBeams, RotatedSensorAndIntegration) {
   for (int k = 0; k < 6; ++k) {  // 6 misses: -2.43 < -2 (free); 6 hits: +5.08 (occupied)
     std::vector<BeamUpdate> beams;
     IntegrationStats stats;
-    beamsFromCloud(integrator, CloudBeamsConfig{}, reinterpret_cast<const unsigned char*>(&cloud[0].x),
-                   1, sizeof(PointXYZI), pose, &beams, &stats);
+    beamsFromCloud(integrator, CloudBeamsConfig{},
+                   reinterpret_cast<const unsigned char*>(&cloud[0].x), 1, sizeof(PointXYZI), pose,
+                   &beams, &stats);
     ASSERT_EQ(beams.size(), 1u);
     EXPECT_NEAR(beams[0].hit_x, -0.025, 1e-6);
     EXPECT_NEAR(beams[0].hit_y, -2.025, 1e-6);

@@ -69,9 +69,9 @@ TEST(LogOddsCosts, MaximumCombinationOnlyRaisesCosts) {
   all.expand(3, 0);
   writeStateCosts(grid, all, false, cost::kFreeSpace, &master, CombinationMethod::kMaximum);
   EXPECT_EQ(master.cost(0, 0), cost::kLethalObstacle);  // 254 > 100
-  EXPECT_EQ(master.cost(1, 0), 100);                     // free does not lower an earlier cost
-  EXPECT_EQ(master.cost(2, 0), cost::kFreeSpace);        // NO_INFORMATION is always replaced
-  EXPECT_EQ(master.cost(3, 0), 50);                      // unknown writes nothing
+  EXPECT_EQ(master.cost(1, 0), 100);                    // free does not lower an earlier cost
+  EXPECT_EQ(master.cost(2, 0), cost::kFreeSpace);       // NO_INFORMATION is always replaced
+  EXPECT_EQ(master.cost(3, 0), 50);                     // unknown writes nothing
   // Overwrite on the same input lowers cell 1.
   master.setCost(1, 0, 100);
   writeStateCosts(grid, all, false, cost::kFreeSpace, &master, CombinationMethod::kOverwrite);

@@ -10,21 +10,26 @@ from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import OccupancyGrid
 from std_msgs.msg import Bool
 
+from downstream_perception.costmap_client import CostmapClient
+
 
 class CostmapWatch:
     def __init__(self, layer: str, costmap_topic: str = "/costmap/costmap") -> None:
-        self.latest: OccupancyGrid | None = None
-        self.latest_wall = 0.0
+        self.client = CostmapClient(costmap_topic)
         self.done_wall: float | None = None
         self.layer_status: dict[str, str] = {}
         self._layer = f"layer {layer}"
-        rospy.Subscriber(costmap_topic, OccupancyGrid, self._on_grid, queue_size=1)
         rospy.Subscriber("/sim_done", Bool, self._on_done, queue_size=1)
         rospy.Subscriber("/diagnostics", DiagnosticArray, self._on_diag, queue_size=10)
 
-    def _on_grid(self, msg: OccupancyGrid) -> None:
-        self.latest = msg
-        self.latest_wall = time.time()
+    @property
+    def latest(self) -> OccupancyGrid | None:
+        """The current costmap (full grid plus updates), or None before the first one."""
+        return self.client.message() if self.client.received else None
+
+    @property
+    def latest_wall(self) -> float:
+        return self.client.last_change_wall
 
     def _on_done(self, msg: Bool) -> None:
         if msg.data and self.done_wall is None:

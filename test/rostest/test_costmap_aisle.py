@@ -92,12 +92,12 @@ class CostmapAisleTest(unittest.TestCase):
 
     def test_diagnostics_report_integration(self) -> None:
         deadline = time.time() + 5.0
-        while "scan: scans integrated" not in self.watch.layer_status and time.time() < deadline:
+        while "scan: messages integrated" not in self.watch.layer_status and time.time() < deadline:
             time.sleep(0.1)
-        self.assertGreater(int(self.watch.layer_status["scan: scans integrated"]), 20)
-        self.assertEqual(int(self.watch.layer_status["scan: scans rejected"]), 0)
+        self.assertGreater(int(self.watch.layer_status["scan: messages integrated"]), 20)
+        self.assertEqual(int(self.watch.layer_status["scan: messages rejected"]), 0)
         self.assertGreater(
-            float(self.watch.layer_status["scan: clear:mark ratio (all scans)"]), 5.0
+            float(self.watch.layer_status["scan: clear:mark ratio (all messages)"]), 5.0
         )
 
 

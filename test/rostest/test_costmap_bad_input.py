@@ -8,14 +8,14 @@ import math
 import time
 import unittest
 
-import numpy as np
 import rospy
 import rostest
 import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import TransformStamped
-from nav_msgs.msg import OccupancyGrid
 from sensor_msgs.msg import LaserScan
+
+from downstream_perception.costmap_client import CostmapClient
 
 
 def transform(parent: str, child: str, x: float, y: float, stamp: rospy.Time) -> TransformStamped:
@@ -33,14 +33,11 @@ class BadInputTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls) -> None:
         rospy.init_node("test_costmap_bad_input")
-        cls.grids: dict[str, OccupancyGrid] = {}
+        cls.clients = {
+            "ok": CostmapClient("/costmap/costmap"),
+            "absurd": CostmapClient("/costmap_absurd/costmap"),
+        }
         cls.status: dict[str, tuple[int, str, dict[str, str]]] = {}
-        rospy.Subscriber(
-            "/costmap/costmap", OccupancyGrid, lambda m: cls.grids.__setitem__("ok", m)
-        )
-        rospy.Subscriber(
-            "/costmap_absurd/costmap", OccupancyGrid, lambda m: cls.grids.__setitem__("absurd", m)
-        )
 
         def on_diag(msg: DiagnosticArray) -> None:
             for s in msg.status:
@@ -98,10 +95,7 @@ class BadInputTest(unittest.TestCase):
         return False
 
     def cell(self, key: str, x: float, y: float) -> int:
-        g = self.grids[key]
-        i = int(math.floor((x - g.info.origin.position.x) / g.info.resolution))
-        j = int(math.floor((y - g.info.origin.position.y) / g.info.resolution))
-        return int(np.asarray(g.data, dtype=np.int8)[j * g.info.width + i])
+        return self.clients[key].cell(x, y)
 
     def layer(self, name: str = "costmap: layer obstacles") -> tuple[int, str, dict[str, str]]:
         key = next((k for k in self.status if k.endswith(name)), None)
@@ -120,7 +114,9 @@ class BadInputTest(unittest.TestCase):
         good = [1.0] + [math.inf] * 7
         self.publish(self.scan(good), times=5)
         self.assertTrue(
-            self.wait_for(lambda: "ok" in self.grids and self.cell("ok", 1.05, 0.05) == 100)
+            self.wait_for(
+                lambda: self.clients["ok"].received and self.cell("ok", 1.05, 0.05) == 100
+            )
         )
 
         # All-NaN and all -Inf scans: ignored beams, no marks, no crash.
@@ -158,9 +154,9 @@ class BadInputTest(unittest.TestCase):
 
     def test_2_absurd_parameters_are_reported_and_defaults_used(self) -> None:
         self.assertTrue(
-            self.wait_for(lambda: "absurd" in self.grids), "absurd costmap never published"
+            self.wait_for(lambda: self.clients["absurd"].received), "absurd costmap never published"
         )
-        info = self.grids["absurd"].info
+        info = self.clients["absurd"].message().info
         self.assertAlmostEqual(info.resolution, 0.05, places=6)  # default, not -0.1
         self.assertEqual((info.width, info.height), (200, 200))  # 10 m default at 0.05 m
         self.assertTrue(
@@ -172,9 +168,11 @@ class BadInputTest(unittest.TestCase):
         self.assertIn("update_frequency", message)
         self.assertGreaterEqual(int(values["config errors"]), 4)
         layer_key = next(k for k in self.status if k.endswith("costmap_absurd: layer obstacles"))
-        layer_level, layer_message, _ = self.status[layer_key]
+        layer_level, _, layer_values = self.status[layer_key]
         self.assertEqual(layer_level, 2)
-        self.assertIn("p_hit", layer_message)
+        errors = [v for k, v in layer_values.items() if k.startswith("config error ")]
+        self.assertGreaterEqual(int(layer_values["config errors"]), 2)
+        self.assertTrue(any("p_hit" in e for e in errors), errors)
 
 
 if __name__ == "__main__":

@@ -21,9 +21,7 @@ void shiftGridData(std::vector<T>* cells, int size_x, int size_y, int dx, int dy
   const int x_hi = std::min(size_x, size_x + dx);
   const int y_lo = std::max(0, dy);
   const int y_hi = std::min(size_y, size_y + dy);
-  const auto index = [size_x](int x, int y) {
-    return static_cast<std::ptrdiff_t>(y) * size_x + x;
-  };
+  const auto index = [size_x](int x, int y) { return static_cast<std::ptrdiff_t>(y) * size_x + x; };
   if (x_lo < x_hi) {
     for (int y = y_lo; y < y_hi; ++y) {
       const auto src = cells->begin() + index(x_lo, y);

@@ -2,8 +2,15 @@
 // only where the set of lethal cells changed (see core/inflation.h). Must be the last layer.
 #pragma once
 
-#include <mutex>
+#include <dynamic_reconfigure/server.h>
+#include <boost/thread/recursive_mutex.hpp>
 
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/InflationLayerConfig.h"
 #include "downstream_perception/core/inflation.h"
 #include "downstream_perception/layer.h"
 #include "downstream_perception/running_stats.h"
@@ -16,6 +23,7 @@ class InflationLayer : public Layer {
                     double* max_x, double* max_y) override;
   void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
   void matchSize() override;
+  void shiftOrigin(int dx, int dy) override;
   void reset() override;
   void onFootprintChanged() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
@@ -24,7 +32,11 @@ class InflationLayer : public Layer {
   void onInitialize() override;
 
  private:
-  void applyConfig();
+  using ReconfigureServer = dynamic_reconfigure::Server<InflationLayerConfig>;
+  void reconfigure(InflationLayerConfig& config, std::uint32_t level);
+  /// Validates `candidate` (with the footprint's inscribed radius) and rebuilds the Inflator;
+  /// an invalid candidate is logged and the previous valid settings stay.
+  void applyConfig(InflationConfig candidate);
 
   std::mutex mutex_;
   InflationConfig config_;  ///< inscribed_radius comes from the footprint
@@ -34,6 +46,8 @@ class InflationLayer : public Layer {
   InflationStats last_;
   std::size_t updates_ = 0;
   RunningStats update_ms_;
+  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
+  std::unique_ptr<ReconfigureServer> reconfigure_server_;
 };
 
 }  // namespace downstream_perception

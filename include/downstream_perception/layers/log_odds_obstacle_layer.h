@@ -1,19 +1,32 @@
-// downstream_perception/LogOddsObstacleLayer: LaserScan sources integrated into a log-odds grid
-// (hit/miss increments, clamp, exact ray clearing, REP-117 semantics), each scan placed with the
-// transform at its own stamp. The master gets LETHAL (l > occupied_log_odds), FREE
-// (l < free_log_odds) or, for cells in between, nothing (they keep the master's default:
-// NO_INFORMATION when tracking unknown space, else FREE).
+// downstream_perception/LogOddsObstacleLayer: LaserScan and PointCloud2 sources integrated into a
+// log-odds grid (hit/miss increments, clamp, exact ray clearing, REP-117 semantics), each
+// message placed with the transform at its own stamp. The master gets LETHAL
+// (l > occupied_log_odds), FREE (l < free_log_odds) or, for cells in between, nothing (they keep
+// what the master holds). Also: footprint clearing, costmap_2d's combination_method, optional
+// time decay of evidence toward unknown, rolling-window shifts, dynamic_reconfigure.
 #pragma once
+
+#include <dynamic_reconfigure/server.h>
+#include <boost/thread/recursive_mutex.hpp>
 
 #include <memory>
 #include <mutex>
 #include <vector>
 
+#include "downstream_perception/LogOddsObstacleLayerConfig.h"
+#include "downstream_perception/core/log_odds_costs.h"
 #include "downstream_perception/core/log_odds_grid.h"
 #include "downstream_perception/layer.h"
-#include "downstream_perception/layers/laser_scan_source.h"
+#include "downstream_perception/layers/observation_source.h"
 
 namespace downstream_perception {
+
+/// The layer's own settings besides the sensor model (YAML / dynamic_reconfigure keys).
+struct ObstacleLayerConfig {
+  CombinationMethod combination_method = CombinationMethod::kMaximum;  ///< costmap_2d's default
+  bool footprint_clearing_enabled = true;
+  double decay_time_s = 0.0;  ///< s, time constant of the fade toward unknown; 0 = off
+};
 
 class LogOddsObstacleLayer : public Layer {
  public:
@@ -24,6 +37,7 @@ class LogOddsObstacleLayer : public Layer {
                     double* max_x, double* max_y) override;
   void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
   void matchSize() override;
+  void shiftOrigin(int dx, int dy) override;
   void reset() override;
   void activate() override;
   void deactivate() override;
@@ -33,16 +47,31 @@ class LogOddsObstacleLayer : public Layer {
   void onInitialize() override;
 
  private:
+  using ReconfigureServer = dynamic_reconfigure::Server<LogOddsObstacleLayerConfig>;
+  void reconfigure(LogOddsObstacleLayerConfig& config, std::uint32_t level);
   void readSources();
-  void integrateScan(LaserScanSource& source, const AcceptedScan& scan);
+  void integrate(ObservationSource& source, const Observation& observation);
+  void markAllDirty();
+  void clearFootprint(double robot_x, double robot_y, double robot_yaw);
+  void decay();
+  void reportError(const std::string& msg);
 
-  std::mutex grid_mutex_;  ///< guards grid_ and dirty_
+  std::mutex grid_mutex_;  ///< guards grid_, dirty_, evidence_box_
   LogOddsGrid grid_;
   LogOddsConfig grid_config_;
-  CellBounds dirty_;  ///< cells updated since the last updateBounds
+  ObstacleLayerConfig config_;
+  CellBounds dirty_;         ///< cells whose state changed since the last updateBounds
+  CellBounds evidence_box_;  ///< every cell that ever received evidence (decay works here)
+  ros::Time last_decay_;
+  std::size_t cells_decayed_to_unknown_ = 0;
+  std::size_t footprint_cells_cleared_ = 0;
+  std::vector<std::size_t> footprint_scratch_;
   bool track_unknown_space_ = true;
-  std::vector<std::unique_ptr<LaserScanSource>> sources_;
+  std::vector<std::unique_ptr<ObservationSource>> sources_;
+  std::mutex errors_mutex_;
   std::vector<std::string> config_errors_;
+  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
 };
 
 }  // namespace downstream_perception
