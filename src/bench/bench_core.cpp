@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "downstream_perception/core/cloud_beams.h"
 #include "downstream_perception/core/inflation.h"
 #include "downstream_perception/core/log_odds_costs.h"
 #include "downstream_perception/core/scan_integrator.h"
@@ -128,7 +129,8 @@ void runIntegration(int size, double room_half, int beams, int iters) {
 // track_unknown_space false, footprint inscribed radius 0.25 m): integrate the scan, reset the
 // master window (cells whose obstacle state changed, grown by the inflation radius), write the
 // obstacle states, inflate. Reports the inflation step and the whole update.
-void runInflation(int size, double room_half, int beams, double radius, double csf, int iters) {
+void runInflation(int size, double room_half, int beams, double radius, double csf, int iters,
+                  const char* bench = "inflation") {
   const GridGeometry geometry(size, size, 0.05, -size * 0.025, -size * 0.025);
   ScanIntegratorConfig config;
   config.obstacle_max_range = 30.0;
@@ -188,15 +190,175 @@ void runInflation(int size, double room_half, int beams, double radius, double c
     nonzero += c != cost::kFreeSpace;
   }
   std::printf(
-      "{\"bench\": \"inflation\", \"map\": %d, \"room_half_m\": %.3f, \"beams\": %d, "
+      "{\"bench\": \"%s\", \"map\": %d, \"room_half_m\": %.3f, \"beams\": %d, "
       "\"radius_m\": %.2f, \"cost_scaling_factor\": %.1f, \"iters\": %d, "
       "\"inflation_median_ms\": %.4f, \"inflation_p90_ms\": %.4f, \"update_median_ms\": %.4f, "
       "\"first_full_inflation_ms\": %.4f, \"lethal_changed_per_update\": %.1f, "
       "\"cells_recomputed_per_update\": %.0f, \"lethal\": %zu, \"inscribed\": %zu, "
       "\"nonzero\": %zu}\n",
-      size, room_half, beams, radius, csf, iters, medianOf(inflate_ms), p90Of(inflate_ms),
+      bench, size, room_half, beams, radius, csf, iters, medianOf(inflate_ms), p90Of(inflate_ms),
       medianOf(total_ms), first_ms, static_cast<double>(lethal_changed) / iters,
       static_cast<double>(recomputed) / iters, lethal, inscribed, nonzero);
+}
+
+// Rolling window: a 10 m x 10 m robot-centred map (200^2) while the robot drives 1 cell per
+// update through a long corridor of pillars. Per update: shift master, obstacle grid and
+// inflation cache by one cell, integrate a scan, redraw the whole window (as LayeredCostmap does
+// after a shift), inflate. Compared with re-inflating the whole window from scratch.
+void runRolling(int iters) {
+  const int size = 200;
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 5.0;
+  config.raytrace_max_range = 5.0;
+  ScanIntegrator integrator(config);
+  InflationConfig ic;
+  ic.inflation_radius = 0.55;
+  ic.inscribed_radius = 0.25;
+  const int beams = 720;
+  // Corridor walls at y = +-1.5 m with pillars every 2 m; ranges from the robot at (x, 0).
+  const auto scan = [&](double x) {
+    std::vector<float> r(beams);
+    for (int k = 0; k < beams; ++k) {
+      const double a = -M_PI + k * 2.0 * M_PI / beams;
+      const double dx = std::cos(a), dy = std::sin(a);
+      double range = dy != 0 ? 1.5 / std::abs(dy) : INFINITY;
+      for (double px = std::floor(x / 2.0) * 2.0 - 6.0; px < x + 8.0; px += 2.0) {
+        range = std::min(range, rayToCircle(x, 0.0, dx, dy, px, 0.9, 0.15));
+      }
+      r[k] = range > 30.0 ? INFINITY : static_cast<float>(range);
+    }
+    return r;
+  };
+  Inflator incremental(ic, 0.05);
+  Inflator scratch(ic, 0.05);
+  GridGeometry geometry(size, size, 0.05, -5.0, -5.0);
+  LogOddsGrid grid(geometry);
+  Costmap master(geometry, cost::kNoInformation);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(size - 1, size - 1);
+  std::vector<double> update_ms, shift_inflate_ms, full_inflate_ms;
+  for (int i = 0; i < iters + 10; ++i) {
+    const double x = 0.05 * i;
+    const auto ranges = scan(x);
+    const auto t0 = std::chrono::steady_clock::now();
+    if (i > 0) {
+      master.shift(1, 0);
+      grid.shift(1, 0);
+      incremental.shift(1, 0);
+    }
+    integrator.integrate(
+        grid, {ranges.data(), ranges.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0}, {x, 0.0, 0.0});
+    master.reset();
+    writeStateCosts(grid, all, false, cost::kFreeSpace, &master);
+    Costmap copy = master;
+    const auto t1 = std::chrono::steady_clock::now();
+    incremental.update(&master, all);
+    const double t_inflate = msSince(t1);
+    const double t_update = msSince(t0);
+    const auto t2 = std::chrono::steady_clock::now();
+    scratch.reset();
+    scratch.update(&copy, all);
+    const double t_full = msSince(t2);
+    if (i >= 10) {
+      update_ms.push_back(t_update);
+      shift_inflate_ms.push_back(t_inflate);
+      full_inflate_ms.push_back(t_full);
+    }
+  }
+  std::printf(
+      "{\"bench\": \"rolling\", \"map\": %d, \"beams\": %d, \"radius_m\": 0.55, \"iters\": %d, "
+      "\"update_median_ms\": %.4f, \"inflation_median_ms\": %.4f, "
+      "\"full_reinflation_median_ms\": %.4f}\n",
+      size, beams, iters, medianOf(update_ms), medianOf(shift_inflate_ms),
+      medianOf(full_inflate_ms));
+}
+
+// A 640 x 480 depth camera (307,200 points) 0.4 m above the floor looking at a wall 4 m away:
+// the lower part of the image sees the floor (outside the height band), the rest the wall.
+void runCloud(int iters) {
+  const int w = 640, h = 480;
+  std::vector<float> xyz;
+  xyz.reserve(static_cast<std::size_t>(w) * h * 3);
+  const double fx = 525.0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      // Camera frame x forward, y left, z up (already rotated to the body convention).
+      const double dy = -(u - w / 2.0) / fx;
+      const double dz = -(v - h / 2.0) / fx;
+      double t = 4.0;                            // wall at x = 4 m
+      if (dz < 0.0) t = std::min(t, 0.4 / -dz);  // floor 0.4 m below the camera
+      xyz.push_back(static_cast<float>(t));
+      xyz.push_back(static_cast<float>(t * dy));
+      xyz.push_back(static_cast<float>(t * dz));
+    }
+  }
+  const GridGeometry geometry(200, 200, 0.05, -5.0, -5.0);
+  LogOddsGrid grid(geometry);
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 5.0;
+  config.raytrace_max_range = 5.0;
+  ScanIntegrator integrator(config);
+  CloudBeamsConfig cloud;
+  cloud.min_obstacle_height = 0.05;
+  cloud.max_obstacle_height = 1.8;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation().z() = 0.4;
+  std::vector<double> beams_ms, integrate_ms, merged_beams_ms, merged_integrate_ms;
+  std::vector<BeamUpdate> beams;
+  IntegrationStats decisions;
+  CloudBeamsConfig merged = cloud;
+  merged.merge_cell_m = geometry.resolution();
+  std::size_t merged_beams = 0;
+  for (int i = 0; i < iters; ++i) {
+    beams.clear();
+    decisions = IntegrationStats{};
+    const auto t0 = std::chrono::steady_clock::now();
+    beamsFromCloud(integrator, merged, reinterpret_cast<const unsigned char*>(xyz.data()),
+                   static_cast<std::size_t>(w) * h, 3 * sizeof(float), pose, &beams, &decisions);
+    merged_beams_ms.push_back(msSince(t0));
+    merged_beams = beams.size();
+    const auto t1 = std::chrono::steady_clock::now();
+    integrator.integrate(grid, beams, decisions);
+    merged_integrate_ms.push_back(msSince(t1));
+  }
+  for (int i = 0; i < iters; ++i) {
+    beams.clear();
+    decisions = IntegrationStats{};
+    const auto t0 = std::chrono::steady_clock::now();
+    beamsFromCloud(integrator, cloud, reinterpret_cast<const unsigned char*>(xyz.data()),
+                   static_cast<std::size_t>(w) * h, 3 * sizeof(float), pose, &beams, &decisions);
+    beams_ms.push_back(msSince(t0));
+    const auto t1 = std::chrono::steady_clock::now();
+    integrator.integrate(grid, beams, decisions);
+    integrate_ms.push_back(msSince(t1));
+  }
+  std::printf(
+      "{\"bench\": \"cloud\", \"points\": %d, \"beams_in_band\": %zu, \"iters\": %d, "
+      "\"beams_median_ms\": %.4f, \"integrate_median_ms\": %.4f, \"merged_beams\": %zu, "
+      "\"merged_beams_median_ms\": %.4f, \"merged_integrate_median_ms\": %.4f}\n",
+      w * h, beams.size(), iters, medianOf(beams_ms), medianOf(integrate_ms), merged_beams,
+      medianOf(merged_beams_ms), medianOf(merged_integrate_ms));
+}
+
+// One decay pass over a 1000^2 grid whose every cell holds evidence.
+void runDecay(int iters) {
+  const GridGeometry geometry(1000, 1000, 0.05, 0.0, 0.0);
+  LogOddsGrid grid(geometry);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(999, 999);
+  std::vector<double> ms;
+  for (int i = 0; i < iters; ++i) {
+    if (i % 20 == 0) {
+      for (std::size_t c = 0; c < geometry.cellCount(); ++c) grid.setLogOdds(c, c % 2 ? 8.0 : -8.0);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    grid.decay(0.95, all);
+    ms.push_back(msSince(t0));
+  }
+  std::printf("{\"bench\": \"decay\", \"map\": 1000, \"iters\": %d, \"median_ms\": %.4f}\n", iters,
+              medianOf(ms));
 }
 
 }  // namespace
@@ -217,5 +379,16 @@ int main(int argc, char** argv) {
     for (double radius : {0.55, 1.0}) runInflation(size, room_half, 360, radius, 10.0, iters);
     if (size == 1000) runInflation(size, room_half, 3600, 2.5, 3.0, iters);
   }
+  if (only_size != 0) return 0;
+  // Update time against inflation radius and map size (the plot in bench.md).
+  for (int size : {200, 500, 1000}) {
+    const double room_half = size * 0.025 - 0.525;
+    for (double radius : {0.25, 0.55, 1.0, 1.5, 2.5}) {
+      runInflation(size, room_half, 360, radius, 3.0, iters, "inflation_sweep");
+    }
+  }
+  runRolling(iters);
+  runCloud(std::max(10, iters / 10));
+  runDecay(std::max(10, iters / 4));
   return 0;
 }

@@ -158,6 +158,7 @@ void Inflator::resizeTo(const GridGeometry& geometry) {
   dirty_tiles_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, 0);
   dirty_tile_count_ = 0;
   dirty_tile_box_ = CellBounds{};
+  pending_regions_.clear();
   full_recompute_ = true;
 }
 
@@ -178,6 +179,14 @@ void Inflator::shift(int dx, int dy) {
   shiftGridData(&lethal_, nx, ny, dx, dy, std::uint8_t{0});
   shiftGridData(&costs_, nx, ny, dx, dy, std::uint8_t{0});
   geometry_ = shiftedGeometry(geometry_, dx, dy);
+  // Bands still pending from an earlier shift move with the content.
+  std::vector<CellBounds> moved;
+  for (const CellBounds& b : pending_regions_) {
+    const CellBounds m =
+        grow({b.min_x - dx, b.min_y - dy, b.max_x - dx, b.max_y - dy}, 0, geometry_);
+    if (!m.empty()) moved.push_back(m);
+  }
+  pending_regions_.swap(moved);
   // Pending marks referred to the old origin: rather than move them, mark their area in the
   // new frame conservatively by recomputing wherever anything was pending.
   if (dirty_tile_count_ > 0) {
@@ -192,21 +201,25 @@ void Inflator::shift(int dx, int dy) {
     markDirty(pending);
   }
   // Cells that came into view need costs from the lethal cells near them; cells along the edge
-  // the map moved away from may have lost the lethal cells that inflated them. A marked tile is
-  // recomputed out to the inflation radius, so marking the edge row of tiles covers that band.
+  // the map moved away from may have lost lethal cells (now outside) that inflated them. Both
+  // are thin bands: recompute them as regions of their own at the next update.
+  const int r = radius_cells_;
+  const auto band = [&](int x0, int y0, int x1, int y1) {
+    pending_regions_.push_back(grow({x0, y0, x1, y1}, 0, geometry_));
+  };
   if (dx > 0) {
-    markDirty({nx - dx, 0, nx - 1, ny - 1});
-    markDirty({0, 0, 0, ny - 1});
+    band(nx - dx, 0, nx - 1, ny - 1);
+    band(0, 0, r, ny - 1);
   } else if (dx < 0) {
-    markDirty({0, 0, -dx - 1, ny - 1});
-    markDirty({nx - 1, 0, nx - 1, ny - 1});
+    band(0, 0, -dx - 1, ny - 1);
+    band(nx - 1 - r, 0, nx - 1, ny - 1);
   }
   if (dy > 0) {
-    markDirty({0, ny - dy, nx - 1, ny - 1});
-    markDirty({0, 0, nx - 1, 0});
+    band(0, ny - dy, nx - 1, ny - 1);
+    band(0, 0, nx - 1, r);
   } else if (dy < 0) {
-    markDirty({0, 0, nx - 1, -dy - 1});
-    markDirty({0, ny - 1, nx - 1, ny - 1});
+    band(0, 0, nx - 1, -dy - 1);
+    band(0, ny - 1 - r, nx - 1, ny - 1);
   }
 }
 
@@ -296,8 +309,15 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
     std::fill(dirty_tiles_.begin(), dirty_tiles_.end(), 0);
     dirty_tile_count_ = 0;
     dirty_tile_box_ = CellBounds{};
+    pending_regions_.clear();
     full_recompute_ = false;
   } else {
+    for (const CellBounds& region : pending_regions_) {  // edges after a rolling-window shift
+      recompute(region, g);
+      ++stats.regions;
+      stats.cells_recomputed += area(region);
+    }
+    pending_regions_.clear();
     // Where did the set of lethal cells change?
     const int tiles_x = (g.sizeX() >> kTileShift) + 1;
     for (int y = w.min_y; !w.empty() && y <= w.max_y; ++y) {

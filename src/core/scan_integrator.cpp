@@ -16,6 +16,7 @@ void IntegrationStats::accumulate(const IntegrationStats& o) {
   beams_invalid += o.beams_invalid;
   beams_beyond_obstacle_range += o.beams_beyond_obstacle_range;
   points_outside_height += o.points_outside_height;
+  points_merged += o.points_merged;
   cells_cleared += o.cells_cleared;
   cells_marked += o.cells_marked;
   cells_changed += o.cells_changed;
@@ -287,6 +288,7 @@ IntegrationStats ScanIntegrator::integrate(LogOddsGrid& grid, const std::vector<
   stats.beams_no_return = decisions.beams_no_return;
   stats.beams_beyond_obstacle_range = decisions.beams_beyond_obstacle_range;
   stats.points_outside_height = decisions.points_outside_height;
+  stats.points_merged = decisions.points_merged;
   return stats;
 }
 

@@ -139,6 +139,8 @@ void LogOddsObstacleLayer::readSources() {
     snh.param("raytrace_max_range", ic.raytrace_max_range, d.raytrace_max_range);
     snh.param("inf_is_valid", ic.inf_is_valid, d.inf_is_valid);
     snh.param("range_max_is_no_return", ic.range_max_is_no_return, d.range_max_is_no_return);
+    // One beam per grid cell of a cloud: the same cells, a fraction of the ray walks.
+    config.cloud.merge_cell_m = layered_costmap_->costmap().geometry().resolution();
     std::string why = ic.validate();
     if (why.empty()) why = config.cloud.validate();
     if (config.tf_queue_size < 1 || config.tf_queue_size > 10000) {
@@ -345,6 +347,7 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     status.add(p + "beams invalid (total)", h.total.beams_invalid);
     status.add(p + "beams no return (total)", h.total.beams_no_return);
     status.add(p + "points outside height band (total)", h.total.points_outside_height);
+    status.add(p + "points merged into a cell's beam (total)", h.total.points_merged);
     status.add(p + "current", current);
   }
   status.add("cells occupied", n_occ);

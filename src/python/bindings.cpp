@@ -219,6 +219,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("cells_marked", &IntegrationStats::cells_marked)
       .def_readonly("cells_changed", &IntegrationStats::cells_changed)
       .def_readonly("points_outside_height", &IntegrationStats::points_outside_height)
+      .def_readonly("points_merged", &IntegrationStats::points_merged)
       .def_property_readonly(
           "touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
           "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
@@ -277,7 +278,7 @@ PYBIND11_MODULE(_core, m) {
           [](ScanIntegrator& self, LogOddsGrid& grid,
              py::array_t<float, py::array::c_style | py::array::forcecast> points,
              py::array_t<double, py::array::c_style | py::array::forcecast> grid_from_sensor,
-             double min_obstacle_height, double max_obstacle_height) {
+             double min_obstacle_height, double max_obstacle_height, double merge_cell_m) {
             if (points.ndim() != 2 || points.shape(1) != 3) {
               throw std::invalid_argument("points must be an (N, 3) array");
             }
@@ -285,7 +286,7 @@ PYBIND11_MODULE(_core, m) {
                 grid_from_sensor.shape(1) != 4) {
               throw std::invalid_argument("grid_from_sensor must be a 4 x 4 matrix");
             }
-            const CloudBeamsConfig config{min_obstacle_height, max_obstacle_height};
+            const CloudBeamsConfig config{min_obstacle_height, max_obstacle_height, merge_cell_m};
             const std::string why = config.validate();
             if (!why.empty()) throw std::invalid_argument(why);
             Eigen::Matrix4d m;
@@ -303,8 +304,10 @@ PYBIND11_MODULE(_core, m) {
           },
           py::arg("grid"), py::arg("points"), py::arg("grid_from_sensor"),
           py::arg("min_obstacle_height") = 0.0, py::arg("max_obstacle_height") = 2.0,
+          py::arg("merge_cell_m") = 0.0,
           "Integrates an (N, 3) point cloud in the sensor frame placed by the 4 x 4 transform "
-          "grid_from_sensor; points outside the height band (grid frame z, m) are skipped.");
+          "grid_from_sensor; points outside the height band (grid frame z, m) are skipped; with "
+          "merge_cell_m > 0 one beam per merge cell.");
 
   // ----------------------------------------------------------------- SE(2)
   py::class_<Pose2D>(m, "Pose2D")

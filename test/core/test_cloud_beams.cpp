@@ -80,3 +80,43 @@ TEST(CloudBeams, RotatedSensorAndIntegration) {
   EXPECT_FALSE((CloudBeamsConfig{1.0, 0.5}).validate().empty());
   EXPECT_TRUE(CloudBeamsConfig{}.validate().empty());
 }
+
+TEST(CloudBeams, MergeCellsGiveOneBeamPerCellAndTheSameMarks) {
+  // A dense patch of a wall (20 x 20 points within one 5 cm cell, plus one point in the next
+  // cell): merged, 2 beams instead of 401, and the grid ends up the same for the hit cells.
+  std::vector<PointXYZI> cloud;
+  for (int i = 0; i < 20; ++i) {
+    for (int j = 0; j < 20; ++j) {
+      cloud.push_back({2.005f + 0.002f * i, 0.005f + 0.002f * j, 0.0f, 0.0f});
+    }
+  }
+  cloud.push_back({2.075f, 0.025f, 0.0f, 0.0f});
+  ScanIntegrator integrator(ScanIntegratorConfig{});
+  const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  CloudBeamsConfig merged;
+  merged.min_obstacle_height = -1.0;
+  merged.merge_cell_m = 0.05;
+  CloudBeamsConfig each = merged;
+  each.merge_cell_m = 0.0;
+  std::vector<BeamUpdate> merged_beams, each_beams;
+  IntegrationStats merged_stats, each_stats;
+  const auto* data = reinterpret_cast<const unsigned char*>(&cloud[0].x);
+  beamsFromCloud(integrator, merged, data, cloud.size(), sizeof(PointXYZI), pose, &merged_beams,
+                 &merged_stats);
+  beamsFromCloud(integrator, each, data, cloud.size(), sizeof(PointXYZI), pose, &each_beams,
+                 &each_stats);
+  EXPECT_EQ(merged_beams.size(), 2u);
+  EXPECT_EQ(merged_stats.points_merged, 399u);
+  EXPECT_EQ(each_beams.size(), 401u);
+  LogOddsGrid a(GridGeometry(100, 100, 0.05, -2.5, -2.5));
+  LogOddsGrid b(GridGeometry(100, 100, 0.05, -2.5, -2.5));
+  integrator.integrate(a, merged_beams, merged_stats);
+  integrator.integrate(b, each_beams, each_stats);
+  for (const double x : {2.025, 2.075}) {
+    CellIndex c;
+    ASSERT_TRUE(a.geometry().worldToCell(x, 0.025, &c));
+    EXPECT_EQ(a.units(a.geometry().index(c.x, c.y)), b.units(b.geometry().index(c.x, c.y)));
+    EXPECT_GT(a.units(a.geometry().index(c.x, c.y)), 0);
+  }
+  EXPECT_FALSE((CloudBeamsConfig{0.0, 1.0, -0.05}).validate().empty());
+}

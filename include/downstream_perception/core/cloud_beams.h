@@ -7,7 +7,9 @@
 // obstacles, and a ray to them says nothing about the obstacle band). A point inside the band
 // is a return at its horizontal distance from the sensor origin: it marks within
 // obstacle_max_range and clears from the sensor to it, like a laser beam. Non-finite points
-// (NaN from depth holes) are invalid and ignored.
+// (NaN from depth holes) are invalid and ignored. With merge_cell_m > 0 only the first point
+// per merge cell casts a beam: the same cells are marked, and the clearing rays differ from the
+// per-point ones only within that cell's width at the far end.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -23,6 +25,10 @@ namespace downstream_perception {
 struct CloudBeamsConfig {
   double min_obstacle_height = 0.0;  ///< m, in the grid's frame
   double max_obstacle_height = 2.0;  ///< m, in the grid's frame
+  /// m: points whose horizontal position falls in the same square of this size give one beam
+  /// (a depth camera puts hundreds of pixels into one grid cell; their rays are the same to a
+  /// cell). 0 = one beam per point. The obstacle layer sets it to the grid resolution.
+  double merge_cell_m = 0.0;
 
   /// Empty if valid, else the reason.
   std::string validate() const;

@@ -107,7 +107,8 @@ class Inflator {
   std::vector<std::uint8_t> costs_;
   std::vector<std::uint8_t> dirty_tiles_;
   std::size_t dirty_tile_count_ = 0;
-  CellBounds dirty_tile_box_;  ///< in tiles
+  CellBounds dirty_tile_box_;                ///< in tiles
+  std::vector<CellBounds> pending_regions_;  ///< bands to recompute after a shift
   std::vector<std::int32_t> scratch_;
   bool full_recompute_ = true;
 };

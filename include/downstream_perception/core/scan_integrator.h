@@ -53,6 +53,7 @@ struct IntegrationStats {
   std::size_t beams_invalid = 0;    ///< NaN, -Inf, outside [range_min, range_max]
   std::size_t beams_beyond_obstacle_range = 0;  ///< returns too far (or near) to mark
   std::size_t points_outside_height = 0;        ///< cloud points outside [min, max]_obstacle_height
+  std::size_t points_merged = 0;  ///< cloud points sharing a merge cell with an earlier one
   /// Cells walked by clearing rays, per beam (a cell two beams cross counts twice, as in the
   /// lesson's "a 10 m beam clears ~200 cells"). Each cell still receives at most one miss
   /// update per scan, and none if it was hit in the same scan.
