@@ -31,6 +31,10 @@ COSTMAP2D_INFLATION_MS = {
 }
 
 
+# abewley/sort per-frame time on the anchor notes' 2-D scene (us), by number of objects.
+SORT_US = {10: 616, 50: 2721, 200: 10850}
+
+
 def find_bench_binary() -> Path:
     for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(":"):
         candidate = Path(prefix) / "lib" / "downstream_perception" / "downstream_perception_bench"
@@ -132,6 +136,7 @@ def main() -> None:
     rolling = next(r for r in rows if r["bench"] == "rolling")
     cloud = next(r for r in rows if r["bench"] == "cloud")
     decay = next(r for r in rows if r["bench"] == "decay")
+    tracker = [r for r in rows if r["bench"] == "tracker"]
     plotted = plot_sweep(sweep, out / "bench_inflation.png")
     binding = python_binding_overhead()
     sim = simulator_speed()
@@ -232,6 +237,21 @@ def main() -> None:
         f"- decay pass over a 1000^2 grid full of evidence: {decay['median_ms']:.2f} ms (runs at "
         "most every 0.1 s, over the box of cells that ever received evidence)",
         "",
+        "## Tracker (metric mode, defaults)",
+        "",
+        "N objects at constant velocity (an object leaving the square is replaced by a new one), "
+        "10 Hz, 90 % detection probability, 0.1 m noise, N/20 clutter detections per frame. "
+        "SORT (abewley/sort) on a comparable 2-D scene, anchor notes: 616 / 2,721 / 10,850 us "
+        "per frame at N = 10 / 50 / 200; the goal is <= 15 / 50 / 300 us.",
+        "",
+        "| objects | us / frame (p90) | SORT us / frame | ID switches in the run (truth-based) |",
+        "|---|---|---|---|",
+        *(
+            f"| {int(r['objects'])} | {r['median_us']:.1f} ({r['p90_us']:.1f}) | "
+            f"{SORT_US.get(int(r['objects']), '')} | {int(r['id_switches'])} |"
+            for r in tracker
+        ),
+        "",
         "## Python side",
         "",
         f"- one 360-beam scan through the pybind11 binding (200^2): median "
@@ -251,6 +271,7 @@ def main() -> None:
                 "rolling": rolling,
                 "cloud": cloud,
                 "decay": decay,
+                "tracker": tracker,
                 "binding": binding,
                 "sim": sim,
             },

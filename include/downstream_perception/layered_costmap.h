@@ -34,6 +34,11 @@ class LayeredCostmap {
   bool hasRobotPose() const { return have_robot_pose_; }
   /// The next updateMap() redraws the whole master (a layer was enabled or disabled, cleared).
   void requestFullRedraw() { full_redraw_ = true; }
+  /// Returns and clears a pending full-redraw request (hosts that run their own update loop,
+  /// such as the costmap_2d adapter).
+  bool takeFullRedrawRequest() { return full_redraw_.exchange(false); }
+  /// For hosts that run their own update loop: whether the robot pose of this update is known.
+  void setHaveRobotPose(bool known) { have_robot_pose_ = known; }
   void setRollingWindow(bool rolling) { rolling_window_ = rolling; }
   bool isRolling() const { return rolling_window_; }
   /// Resets the master and every layer.

@@ -1,0 +1,437 @@
+#include "downstream_perception/core/tracking/tracker.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "downstream_perception/core/tracking/assignment.h"
+
+namespace downstream_perception {
+
+std::string TrackerConfig::validate() const {
+  std::ostringstream why;
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!(gate_confidence > 0.0 && gate_confidence < 1.0)) {
+    why << "gate_confidence must be in (0, 1), got " << gate_confidence;
+  } else if (!(duplicate_confidence > 0.0 && duplicate_confidence < 1.0)) {
+    why << "duplicate_confidence must be in (0, 1), got " << duplicate_confidence;
+  } else if (!(min_iou >= 0.0 && min_iou <= 1.0)) {
+    why << "min_iou must be in [0, 1], got " << min_iou;
+  } else if (!positive(accel_psd)) {
+    why << "accel_psd must be finite and > 0, got " << accel_psd;
+  } else if (!positive(measurement_std)) {
+    why << "measurement_std must be finite and > 0, got " << measurement_std;
+  } else if (!positive(initial_velocity_std)) {
+    why << "initial_velocity_std must be finite and > 0, got " << initial_velocity_std;
+  } else if (min_hits < 1 || min_hits > 1000) {
+    why << "min_hits must be in [1, 1000], got " << min_hits;
+  } else if (!(std::isfinite(max_age_s) && max_age_s >= 0.0)) {
+    why << "max_age_s must be finite and >= 0 s, got " << max_age_s;
+  } else if (!(low_score >= 0.0 && low_score <= high_score && high_score <= 1.0)) {
+    why << "need 0 <= low_score <= high_score <= 1, got " << low_score << " and " << high_score;
+  }
+  return why.str();
+}
+
+void TrackerStats::accumulate(const TrackerStats& o) {
+  detections += o.detections;
+  detections_ignored_low_score += o.detections_ignored_low_score;
+  detections_rejected_invalid += o.detections_rejected_invalid;
+  matched_first_pass += o.matched_first_pass;
+  matched_second_pass += o.matched_second_pass;
+  unmatched_outside_gate += o.unmatched_outside_gate;
+  births += o.births;
+  duplicates_removed += o.duplicates_removed;
+  deaths += o.deaths;
+  id_switches += o.id_switches;
+  tracks = o.tracks;
+  confirmed = o.confirmed;
+}
+
+namespace {
+
+bool validDetection(const Detection& d, TrackerConfig::Mode mode) {
+  if (!std::isfinite(d.score)) return false;
+  if (mode == TrackerConfig::Mode::kImage) {
+    return d.box.validate().empty() && d.box.height() > 0.0 && d.box.width() > 0.0;
+  }
+  if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.cov_xx) ||
+      !std::isfinite(d.cov_xy) || !std::isfinite(d.cov_yy) || !std::isfinite(d.size_x) ||
+      !std::isfinite(d.size_y)) {
+    return false;
+  }
+  // A covariance must be symmetric positive semi-definite (all zero = "use the default").
+  return d.cov_xx >= 0.0 && d.cov_yy >= 0.0 && d.cov_xx * d.cov_yy - d.cov_xy * d.cov_xy >= 0.0;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+struct Tracker::Impl {
+  explicit Impl(const TrackerConfig& c) : config(c) {
+    gate = chiSquareQuantile(2, c.gate_confidence);
+    duplicate_gate = chiSquareQuantile(2, c.duplicate_confidence);
+  }
+  virtual ~Impl() = default;
+  virtual TrackerStats step(double stamp_s, const std::vector<Detection>& detections) = 0;
+  virtual void clear() = 0;
+
+  TrackerConfig config;
+  double gate = 9.21;
+  double duplicate_gate = 4.61;
+  std::vector<Track> tracks;
+  std::vector<std::uint64_t> assignment;
+  std::uint64_t next_id = 1;
+  bool started = false;
+  double last_stamp = 0.0;
+  std::map<int, std::uint64_t> track_of_truth;
+};
+
+namespace {
+
+template <int D>
+struct Core : Tracker::Impl {
+  using Filter = ConstantVelocityKalman<D>;
+  using Vec = typename Filter::Vec;
+  using Mat = typename Filter::Mat;
+
+  struct State {
+    Filter filter;
+    double birth_s = 0.0;
+    double last_update_s = 0.0;
+    double lambda_max = 0.0;  ///< largest eigenvalue of the position covariance (metric gate)
+  };
+
+  // Largest eigenvalue of a symmetric 2 x 2 matrix (closed form); unused for D = 4.
+  static double maxEigen(const Mat& m) {
+    if constexpr (D == 2) {
+      const double mean = 0.5 * (m(0, 0) + m(1, 1));
+      const double half_diff = 0.5 * (m(0, 0) - m(1, 1));
+      return mean + std::sqrt(half_diff * half_diff + m(0, 1) * m(1, 0));
+    } else {
+      return m.trace();
+    }
+  }
+  std::vector<State> states;  // parallel to tracks
+
+  explicit Core(const TrackerConfig& c) : Tracker::Impl(c) {}
+
+  void clear() override {
+    tracks.clear();
+    states.clear();
+    assignment.clear();
+    track_of_truth.clear();
+    started = false;
+  }
+
+  // Measurement and its noise for a detection.
+  void measurement(const Detection& d, Vec* z, Mat* R) const {
+    if constexpr (D == 2) {
+      (*z) << d.x, d.y;
+      if (d.cov_xx > 0.0 || d.cov_yy > 0.0) {
+        (*R) << d.cov_xx, d.cov_xy, d.cov_xy, d.cov_yy;
+      } else {
+        *R = Mat::Identity() * config.measurement_std * config.measurement_std;
+      }
+    } else {
+      (*z) << d.box.centerX(), d.box.centerY(), d.box.width(), d.box.height();
+      const double s = config.measurement_std * d.box.height();
+      *R = Mat::Identity() * s * s;
+    }
+  }
+
+  Vec processNoise(const State& s) const {
+    if constexpr (D == 2) {
+      return Vec::Constant(config.accel_psd);
+    } else {
+      const double h = std::max(1.0, s.filter.position()(3));
+      return Vec::Constant(config.accel_psd * h * h);
+    }
+  }
+
+  // Cost of giving detection d to track t (kForbidden outside the gate).
+  double cost(std::size_t t, const Detection& d, const Vec& z, const Mat& R) const {
+    if (config.class_aware && d.class_id >= 0 && tracks[t].class_id >= 0 &&
+        d.class_id != tracks[t].class_id) {
+      return kForbidden;
+    }
+    if constexpr (D == 2) {
+      // Cheap bound first: d^2 >= |r|^2 / lambda_max(S) and lambda_max(S) <= lambda_max(P) +
+      // lambda_max(R), so far pairs are rejected without forming S (most pairs in a crowd).
+      const Vec r = z - states[t].filter.position();
+      const double r2 = r.squaredNorm();
+      if (r2 > gate * (states[t].lambda_max + maxEigen(R))) return kForbidden;
+      const Mat S = states[t].filter.innovationCov(R);
+      const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+      if (!(det > 0.0)) return kForbidden;
+      const double d2 =
+          (S(1, 1) * r(0) * r(0) - (S(0, 1) + S(1, 0)) * r(0) * r(1) + S(0, 0) * r(1) * r(1)) / det;
+      return d2 <= gate ? d2 : kForbidden;
+    } else {
+      (void)z, (void)R;
+      const Vec p = states[t].filter.position();
+      const double overlap = iou(Box::fromCenter(p(0), p(1), p(2), p(3)), d.box);
+      return overlap >= config.min_iou && overlap > 0.0 ? 1.0 - overlap : kForbidden;
+    }
+  }
+
+  // Assigns detections `dets` (indices) to tracks `cands` (indices); fills match_of_track.
+  std::size_t associate(const std::vector<std::size_t>& cands, const std::vector<std::size_t>& dets,
+                        const std::vector<Detection>& all, const std::vector<Vec>& z,
+                        const std::vector<Mat>& R, std::vector<int>* det_of_track,
+                        std::vector<int>* track_of_det) {
+    if (cands.empty() || dets.empty()) return 0;
+    Eigen::MatrixXd c(cands.size(), dets.size());
+    for (std::size_t i = 0; i < cands.size(); ++i) {
+      for (std::size_t j = 0; j < dets.size(); ++j) {
+        c(i, j) = cost(cands[i], all[dets[j]], z[dets[j]], R[dets[j]]);
+      }
+    }
+    const std::vector<int> match = solveAssignment(c);
+    std::size_t matched = 0;
+    for (std::size_t i = 0; i < cands.size(); ++i) {
+      if (match[i] < 0) continue;
+      (*det_of_track)[cands[i]] = static_cast<int>(dets[match[i]]);
+      (*track_of_det)[dets[match[i]]] = static_cast<int>(cands[i]);
+      ++matched;
+    }
+    return matched;
+  }
+
+  // Two established tracks on one object (one born while the other coasted just outside its
+  // gate) would take turns with its detections forever. When a track that got no detection
+  // this frame sits within the duplicate gate of one that did (squared Mahalanobis distance of
+  // their positions under the sum of their covariances), the coasting one goes. Two tracks
+  // that both took detections are two objects, however close.
+  std::size_t removeDuplicates() {
+    const double limit = duplicate_gate;
+    std::vector<char> gone(tracks.size(), 0);
+    std::size_t removed = 0;
+    for (std::size_t a = 0; a < tracks.size(); ++a) {
+      if (gone[a] || tracks[a].state == TrackState::kTentative) continue;
+      const Vec pa = states[a].filter.position();
+      const Mat ca = states[a].filter.positionCov();
+      const double la = maxEigen(ca);
+      for (std::size_t b = a + 1; b < tracks.size(); ++b) {
+        if (gone[b] || tracks[b].state == TrackState::kTentative) continue;
+        const bool a_coasts = tracks[a].state == TrackState::kCoasting;
+        const bool b_coasts = tracks[b].state == TrackState::kCoasting;
+        if (a_coasts == b_coasts) continue;  // both seen (two objects) or both unseen
+        const Vec r = states[b].filter.position() - pa;
+        const double lb = maxEigen(states[b].filter.positionCov());
+        if (r.squaredNorm() > limit * (la + lb)) continue;
+        const Mat S = ca + states[b].filter.positionCov();
+        if (r.dot(S.ldlt().solve(r)) > limit) continue;
+        const std::size_t loser = a_coasts ? a : b;
+        gone[loser] = 1;
+        ++removed;
+        if (loser == a) break;
+      }
+    }
+    if (removed == 0) return 0;
+    std::size_t out = 0;
+    for (std::size_t t = 0; t < tracks.size(); ++t) {
+      if (gone[t]) continue;
+      tracks[out] = tracks[t];
+      states[out] = states[t];
+      ++out;
+    }
+    tracks.resize(out);
+    states.resize(out);
+    return removed;
+  }
+
+  void refresh(std::size_t t, double now) {
+    Track& track = tracks[t];
+    const State& s = states[t];
+    const Vec p = s.filter.position();
+    const Vec v = s.filter.velocity();
+    track.position = p.template head<2>();
+    track.velocity = v.template head<2>();
+    track.position_cov = s.filter.positionCov().template topLeftCorner<2, 2>();
+    track.velocity_cov = s.filter.velocityCov().template topLeftCorner<2, 2>();
+    if constexpr (D == 4) {
+      track.size_x = p(2);
+      track.size_y = p(3);
+    }
+    track.age_s = now - s.birth_s;
+    track.time_since_update_s = now - s.last_update_s;
+  }
+
+  TrackerStats step(double now, const std::vector<Detection>& detections) override {
+    if (!std::isfinite(now)) throw std::invalid_argument("tracker: stamp must be finite");
+    if (started && now < last_stamp) {
+      throw std::invalid_argument("tracker: stamp " + std::to_string(now) +
+                                  " s is older than the previous frame's " +
+                                  std::to_string(last_stamp) + " s");
+    }
+    const double dt = started ? now - last_stamp : 0.0;
+    started = true;
+    last_stamp = now;
+    TrackerStats stats;
+    stats.detections = detections.size();
+
+    for (State& s : states) {
+      s.filter.predict(dt, processNoise(s));
+      if constexpr (D == 2) s.lambda_max = maxEigen(s.filter.positionCov());
+    }
+
+    // Split detections by score; measurements once per detection.
+    std::vector<Vec> z(detections.size());
+    std::vector<Mat> R(detections.size());
+    std::vector<std::size_t> high, low;
+    for (std::size_t j = 0; j < detections.size(); ++j) {
+      const Detection& d = detections[j];
+      if (!validDetection(d, config.mode)) {
+        ++stats.detections_rejected_invalid;
+        continue;
+      }
+      if (d.score < config.low_score || (d.score < config.high_score && !config.second_pass)) {
+        ++stats.detections_ignored_low_score;
+        continue;
+      }
+      measurement(d, &z[j], &R[j]);
+      (d.score >= config.high_score ? high : low).push_back(j);
+    }
+
+    std::vector<int> det_of_track(tracks.size(), -1);
+    std::vector<int> track_of_det(detections.size(), -1);
+    // Established tracks choose first, so a tentative duplicate (born from one detection that
+    // fell outside a coasting track's gate) cannot take the object's next detection from it.
+    std::vector<std::size_t> established, tentative;
+    for (std::size_t t = 0; t < tracks.size(); ++t) {
+      (tracks[t].state == TrackState::kTentative ? tentative : established).push_back(t);
+    }
+    stats.matched_first_pass =
+        associate(established, high, detections, z, R, &det_of_track, &track_of_det);
+    std::vector<std::size_t> high_left;
+    for (const std::size_t j : high) {
+      if (track_of_det[j] < 0) high_left.push_back(j);
+    }
+    stats.matched_first_pass +=
+        associate(tentative, high_left, detections, z, R, &det_of_track, &track_of_det);
+    if (config.second_pass && !low.empty()) {
+      // Low-score detections may only continue established tracks.
+      std::vector<std::size_t> rest;
+      for (std::size_t t = 0; t < tracks.size(); ++t) {
+        if (det_of_track[t] < 0 && tracks[t].state != TrackState::kTentative) rest.push_back(t);
+      }
+      stats.matched_second_pass =
+          associate(rest, low, detections, z, R, &det_of_track, &track_of_det);
+    }
+
+    // Updates, coasting, deaths.
+    std::vector<Track> kept_tracks;
+    std::vector<State> kept_states;
+    kept_tracks.reserve(tracks.size() + high.size());
+    kept_states.reserve(tracks.size() + high.size());
+    assignment.assign(detections.size(), 0);
+    for (std::size_t t = 0; t < tracks.size(); ++t) {
+      Track& track = tracks[t];
+      State& s = states[t];
+      const int j = det_of_track[t];
+      if (j >= 0) {
+        const Detection& d = detections[j];
+        s.filter.update(z[j], R[j]);
+        s.last_update_s = now;
+        ++track.hits;
+        track.score = d.score;
+        if constexpr (D == 2) {
+          track.size_x = d.size_x;
+          track.size_y = d.size_y;
+        }
+        if (track.class_id < 0) track.class_id = d.class_id;
+        if (track.state == TrackState::kCoasting ||
+            (track.state == TrackState::kTentative && track.hits >= config.min_hits)) {
+          track.state = TrackState::kConfirmed;
+        }
+        track.truth_id = d.truth_id;
+        assignment[j] = track.id;
+        // As MOT metrics do: only tracks that are reported (confirmed) can switch identity.
+        if (d.truth_id >= 0 && track.state == TrackState::kConfirmed) {
+          auto it = track_of_truth.find(d.truth_id);
+          if (it != track_of_truth.end() && it->second != track.id) ++stats.id_switches;
+          track_of_truth[d.truth_id] = track.id;
+        }
+      } else if (track.state == TrackState::kTentative ||
+                 now - s.last_update_s > config.max_age_s) {
+        ++stats.deaths;
+        continue;
+      } else {
+        track.state = TrackState::kCoasting;
+      }
+      kept_tracks.push_back(track);
+      kept_states.push_back(s);
+    }
+    tracks.swap(kept_tracks);
+    states.swap(kept_states);
+    if constexpr (D == 2) stats.duplicates_removed = removeDuplicates();
+    stats.deaths += stats.duplicates_removed;
+
+    // Births from unmatched high-score detections.
+    for (const std::size_t j : high) {
+      if (track_of_det[j] >= 0) continue;
+      ++stats.unmatched_outside_gate;
+      const Detection& d = detections[j];
+      Track track;
+      track.id = next_id++;
+      track.class_id = d.class_id;
+      track.state = config.min_hits <= 1 ? TrackState::kConfirmed : TrackState::kTentative;
+      track.hits = 1;
+      track.score = d.score;
+      track.truth_id = d.truth_id;
+      track.size_x = d.size_x;
+      track.size_y = d.size_y;
+      double velocity_std = config.initial_velocity_std;
+      if constexpr (D == 4) velocity_std *= d.box.height();
+      State s{Filter(z[j], R[j], velocity_std), now, now};
+      tracks.push_back(track);
+      states.push_back(s);
+      assignment[j] = track.id;
+      if (d.truth_id >= 0 && track.state == TrackState::kConfirmed) {
+        auto it = track_of_truth.find(d.truth_id);
+        if (it != track_of_truth.end() && it->second != track.id) ++stats.id_switches;
+        track_of_truth[d.truth_id] = track.id;
+      }
+      ++stats.births;
+    }
+    for (std::size_t t = 0; t < tracks.size(); ++t) refresh(t, now);
+    stats.tracks = tracks.size();
+    for (const Track& t : tracks) stats.confirmed += t.state != TrackState::kTentative;
+    return stats;
+  }
+};
+
+}  // namespace
+
+Tracker::Tracker(const TrackerConfig& config) {
+  const std::string why = config.validate();
+  if (!why.empty()) throw std::invalid_argument("tracker: " + why);
+  if (config.mode == TrackerConfig::Mode::kImage) {
+    impl_ = std::make_unique<Core<4>>(config);
+  } else {
+    impl_ = std::make_unique<Core<2>>(config);
+  }
+}
+
+Tracker::~Tracker() = default;
+Tracker::Tracker(Tracker&&) noexcept = default;
+Tracker& Tracker::operator=(Tracker&&) noexcept = default;
+
+TrackerStats Tracker::step(double stamp_s, const std::vector<Detection>& detections) {
+  return impl_->step(stamp_s, detections);
+}
+const std::vector<Track>& Tracker::tracks() const {
+  return impl_->tracks;
+}
+const std::vector<std::uint64_t>& Tracker::lastAssignment() const {
+  return impl_->assignment;
+}
+const TrackerConfig& Tracker::config() const {
+  return impl_->config;
+}
+void Tracker::reset() {
+  impl_->clear();
+}
+
+}  // namespace downstream_perception
