@@ -434,4 +434,15 @@ void Tracker::reset() {
   impl_->clear();
 }
 
+void Tracker::setConfig(const TrackerConfig& config) {
+  const std::string why = config.validate();
+  if (!why.empty()) throw std::invalid_argument("tracker: " + why);
+  if (config.mode != impl_->config.mode) {
+    throw std::invalid_argument("tracker: the mode cannot change on a running tracker");
+  }
+  impl_->config = config;
+  impl_->gate = chiSquareQuantile(2, config.gate_confidence);
+  impl_->duplicate_gate = chiSquareQuantile(2, config.duplicate_confidence);
+}
+
 }  // namespace downstream_perception

@@ -122,6 +122,9 @@ class Tracker {
   /// For each detection of the last step: the id of the track that took it, or 0.
   const std::vector<std::uint64_t>& lastAssignment() const;
   const TrackerConfig& config() const;
+  /// New thresholds for a running tracker (tracks are kept). Throws std::invalid_argument if
+  /// the config is invalid or changes the mode.
+  void setConfig(const TrackerConfig& config);
   void reset();
 
   struct Impl;  ///< implementation detail (one per mode), defined in tracker.cpp
