@@ -49,7 +49,8 @@ void Costmap2dLayerAdapter::onInitialize() {
   diagnostics_->setHardwareID("costmap_2d layer " + name_);
   diagnostics_->add("layer " + name_,
                     [this](diagnostic_updater::DiagnosticStatusWrapper& s) { impl_->diagnose(s); });
-  enabled_ = impl_->isEnabled();
+  enabled_ = true;
+  impl_enabled_ = impl_->isEnabled();
   current_ = impl_->isCurrent();
 }
 
@@ -80,27 +81,34 @@ bool Costmap2dLayerAdapter::syncGeometry() {
 void Costmap2dLayerAdapter::updateBounds(double robot_x, double robot_y, double robot_yaw,
                                          double* min_x, double* min_y, double* max_x,
                                          double* max_y) {
-  enabled_ = impl_->isEnabled();
   if (diagnostics_) diagnostics_->update();
-  if (!enabled_) return;
   std::lock_guard<std::recursive_mutex> lock(shadow_->mutex());
-  bool redraw_all = syncGeometry();
-  shadow_->setHaveRobotPose(true);  // costmap_2d only updates with a known robot pose
-  impl_->updateBounds(robot_x, robot_y, robot_yaw, min_x, min_y, max_x, max_y);
-  redraw_all = shadow_->takeFullRedrawRequest() || redraw_all;
-  if (redraw_all) {
-    const GridGeometry& g = shadow_->costmap().geometry();
+  // costmap_2d stops calling a layer whose enabled_ is false, so that flag stays true and our
+  // layer's own switch (dynamic_reconfigure "enabled") is followed here instead.
+  const bool was_enabled = impl_enabled_;
+  impl_enabled_ = impl_->isEnabled();
+  // A layer switched on or off appears or vanishes everywhere.
+  bool redraw_all = shadow_->takeFullRedrawRequest() || was_enabled != impl_enabled_;
+  if (impl_enabled_) {
+    redraw_all = syncGeometry() || redraw_all;
+    shadow_->setHaveRobotPose(true);  // costmap_2d only updates with a known robot pose
+    impl_->updateBounds(robot_x, robot_y, robot_yaw, min_x, min_y, max_x, max_y);
+    redraw_all = shadow_->takeFullRedrawRequest() || redraw_all;
+    current_ = impl_->isCurrent();
+  }
+  const costmap_2d::Costmap2D& master = *layered_costmap_->getCostmap();
+  if (redraw_all && hasCells(master)) {
+    const GridGeometry g = geometryOf(master);
     CellBounds all;
     all.expand(0, 0);
     all.expand(g.sizeX() - 1, g.sizeY() - 1);
     g.expandWorldBox(all, min_x, min_y, max_x, max_y);
   }
-  current_ = impl_->isCurrent();
 }
 
 void Costmap2dLayerAdapter::updateCosts(costmap_2d::Costmap2D& master, int min_i, int min_j,
                                         int max_i, int max_j) {
-  if (!enabled_ || min_i >= max_i || min_j >= max_j) return;
+  if (!impl_enabled_ || min_i >= max_i || min_j >= max_j) return;
   std::lock_guard<std::recursive_mutex> lock(shadow_->mutex());
   Costmap& shadow = shadow_->costmap();
   if (geometryOf(master) != shadow.geometry()) return;  // mirrored at the next updateBounds

@@ -47,6 +47,7 @@ class Costmap2dLayerAdapter : public costmap_2d::Layer {
   std::shared_ptr<downstream_perception::Layer> impl_;
   std::unique_ptr<LayeredCostmap> shadow_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  bool impl_enabled_ = true;  ///< our layer's "enabled" (costmap_2d's enabled_ stays true)
 };
 
 }  // namespace downstream_perception
