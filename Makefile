@@ -12,6 +12,7 @@ help:
 
 deps:
 	@tools/install_deps.sh
+	@tools/python_venv.sh
 
 build: deps
 	@tools/build.sh

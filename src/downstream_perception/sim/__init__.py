@@ -1,6 +1,7 @@
 """Pure-numpy simulation: analytic worlds, a 2-D lidar and robot trajectories."""
 
 from downstream_perception.sim.lidar import Lidar, LidarConfig
+from downstream_perception.sim.objects import Frame, ObjectScene, SceneConfig
 from downstream_perception.sim.trajectory import Trajectory, aisle_drive
 from downstream_perception.sim.world import (
     WORLDS,
@@ -13,6 +14,9 @@ from downstream_perception.sim.world import (
 
 __all__ = [
     "WORLDS",
+    "Frame",
+    "ObjectScene",
+    "SceneConfig",
     "Lidar",
     "LidarConfig",
     "MovingCircle",

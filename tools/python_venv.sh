@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The Python environment for tests and tools that need PyPI packages Debian lacks (motmetrics):
+# a venv in the ignored workspace folder on top of Debian's python3 and its packages
+# (--system-site-packages: rospy, numpy, pandas, scipy come from Debian). Idempotent.
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
+venv="$WS/py-venv"
+if [[ ! -x "$venv/bin/python" ]]; then
+  mkdir -p "$WS"
+  /usr/bin/python3 -m venv --system-site-packages "$venv"
+fi
+if ! "$venv/bin/python" -c "import motmetrics" 2> /dev/null; then
+  # Its dependencies (pandas, scipy, xmltodict) are Debian packages (tools/apt-packages.txt).
+  "$venv/bin/pip" install -q --no-deps "motmetrics==1.4.0"
+fi
+echo "python: $venv ($("$venv/bin/python" -c 'import motmetrics; print("motmetrics", motmetrics.__version__)'))"
