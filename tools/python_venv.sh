@@ -11,6 +11,11 @@ if [[ ! -x "$venv/bin/python" ]]; then
 fi
 if ! "$venv/bin/python" -c "import motmetrics" 2> /dev/null; then
   # Its dependencies (pandas, scipy, xmltodict) are Debian packages (tools/apt-packages.txt).
-  "$venv/bin/pip" install -q --no-deps "motmetrics==1.4.0"
+  if ! "$venv/bin/pip" install -q --no-deps "motmetrics==1.4.0"; then
+    # No PyPI (offline machine): everything else still works; the tracker-scoring pytest is
+    # reported as skipped, not passed.
+    echo "python: WARNING: could not install motmetrics from PyPI; its test will be skipped" >&2
+    exit 0
+  fi
 fi
 echo "python: $venv ($("$venv/bin/python" -c 'import motmetrics; print("motmetrics", motmetrics.__version__)'))"
