@@ -4,10 +4,19 @@
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
 
+#include <sstream>
 #include <string>
 #include <vector>
 
 namespace downstream_perception {
+
+/// A value as it would print (for "parameter ~x = <value> is invalid" messages).
+template <class T>
+std::string toText(const T& value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
 
 inline void addConfigErrors(diagnostic_updater::DiagnosticStatusWrapper& status,
                             const std::vector<std::string>& errors) {

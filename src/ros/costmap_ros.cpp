@@ -11,15 +11,6 @@
 
 namespace downstream_perception {
 
-namespace {
-template <class T>
-std::string str(const T& v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-}  // namespace
-
 CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     // Named after this costmap, not the process: several nodelets share one manager.
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
@@ -202,8 +193,8 @@ bool CostmapRos::robotPose(double* x, double* y, double* yaw) {
     // A chain of static transforms comes back with stamp 0: it is valid at every time.
     const double age = t.header.stamp.isZero() ? 0.0 : (ros::Time::now() - t.header.stamp).toSec();
     if (age > config_.transform_tolerance) {
-      last_pose_error_ = "robot pose is " + str(age) + " s old (transform_tolerance " +
-                         str(config_.transform_tolerance) + " s)";
+      last_pose_error_ = "robot pose is " + toText(age) + " s old (transform_tolerance " +
+                         toText(config_.transform_tolerance) + " s)";
       return false;
     }
     *x = t.transform.translation.x;
@@ -271,9 +262,9 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "updating");
   }
   const GridGeometry& g = layered_costmap_->costmap().geometry();
-  status.add("size (cells)", str(g.sizeX()) + " x " + str(g.sizeY()));
+  status.add("size (cells)", toText(g.sizeX()) + " x " + toText(g.sizeY()));
   status.add("resolution (m)", g.resolution());
-  status.add("origin (m)", str(g.originX()) + ", " + str(g.originY()));
+  status.add("origin (m)", toText(g.originX()) + ", " + toText(g.originY()));
   status.add("rolling window", config_.rolling_window);
   status.add("updates", updates_);
   status.add("update rate requested (Hz)", config_.update_frequency);

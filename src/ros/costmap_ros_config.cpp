@@ -6,17 +6,12 @@
 #include <cmath>
 #include <sstream>
 
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/grid_geometry.h"
 
 namespace downstream_perception {
 
 namespace {
-template <class T>
-std::string str(const T& v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 int cells(double metres, double resolution) {
   return static_cast<int>(std::lround(std::min(metres / resolution, 1e9)));
 }
@@ -59,15 +54,16 @@ void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback
   };
   if (!std::isfinite(c->update_frequency) || c->update_frequency <= 0.0 ||
       c->update_frequency > 1000.0) {
-    reject("update_frequency", str(c->update_frequency), str(fallback.update_frequency));
+    reject("update_frequency", toText(c->update_frequency), toText(fallback.update_frequency));
     c->update_frequency = fallback.update_frequency;
   }
   if (!std::isfinite(c->publish_frequency) || c->publish_frequency < 0.0) {
-    reject("publish_frequency", str(c->publish_frequency), str(fallback.publish_frequency));
+    reject("publish_frequency", toText(c->publish_frequency), toText(fallback.publish_frequency));
     c->publish_frequency = fallback.publish_frequency;
   }
   if (!std::isfinite(c->transform_tolerance) || c->transform_tolerance <= 0.0) {
-    reject("transform_tolerance", str(c->transform_tolerance), str(fallback.transform_tolerance));
+    reject("transform_tolerance", toText(c->transform_tolerance),
+           toText(fallback.transform_tolerance));
     c->transform_tolerance = fallback.transform_tolerance;
   }
   const std::string why =
@@ -76,11 +72,11 @@ void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback
                                    c->origin_y)
           : std::string("width/height/resolution must be finite and positive");
   if (!why.empty()) {
-    reject(
-        "width/height/resolution/origin",
-        str(c->width) + " x " + str(c->height) + " m at " + str(c->resolution) + " m (" + why + ")",
-        str(fallback.width) + " x " + str(fallback.height) + " m at " + str(fallback.resolution) +
-            " m");
+    reject("width/height/resolution/origin",
+           toText(c->width) + " x " + toText(c->height) + " m at " + toText(c->resolution) +
+               " m (" + why + ")",
+           toText(fallback.width) + " x " + toText(fallback.height) + " m at " +
+               toText(fallback.resolution) + " m");
     c->width = fallback.width;
     c->height = fallback.height;
     c->resolution = fallback.resolution;
