@@ -319,3 +319,31 @@ TEST(Tracker, DuplicateTracksOnOneObjectAreMergedButNeighboursAreNot) {
   EXPECT_EQ(duplicates, 1u);
   EXPECT_EQ(merge.tracks().size(), 1u);
 }
+
+TEST(Assignment, SparseEntriesEqualTheDenseMatrix) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int rows = 1 + static_cast<int>(rng() % 30);
+    const int cols = 1 + static_cast<int>(rng() % 30);
+    Eigen::MatrixXd dense = Eigen::MatrixXd::Constant(rows, cols, kForbidden);
+    std::vector<CostEntry> entries;
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        if (rng() % 5 != 0) continue;  // ~20 % allowed: several groups
+        dense(r, c) = u(rng);
+        entries.push_back({r, c, dense(r, c)});
+      }
+    }
+    const std::vector<int> a = solveAssignment(dense);
+    const std::vector<int> b = solveAssignment(rows, cols, entries);
+    double cost_a = 0.0, cost_b = 0.0;
+    int pairs_a = 0, pairs_b = 0;
+    for (int r = 0; r < rows; ++r) {
+      if (a[r] >= 0) cost_a += dense(r, a[r]), ++pairs_a;
+      if (b[r] >= 0) cost_b += dense(r, b[r]), ++pairs_b;
+    }
+    ASSERT_EQ(pairs_a, pairs_b) << trial;
+    ASSERT_NEAR(cost_a, cost_b, 1e-9) << trial;
+  }
+}

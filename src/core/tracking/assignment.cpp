@@ -71,37 +71,62 @@ int findRoot(std::vector<int>& parent, int i) {
 }  // namespace
 
 std::vector<int> solveAssignment(const Eigen::MatrixXd& cost) {
+  std::vector<CostEntry> entries;
+  for (int r = 0; r < cost.rows(); ++r) {
+    for (int c = 0; c < cost.cols(); ++c) {
+      if (std::isfinite(cost(r, c))) entries.push_back({r, c, cost(r, c)});
+    }
+  }
+  return solveAssignment(static_cast<int>(cost.rows()), static_cast<int>(cost.cols()), entries);
+}
+
+std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry>& entries) {
   // Gating leaves the matrix sparse: rows and columns linked by allowed pairs form independent
-  // groups (objects far apart never compete), and each is solved on its own. This keeps a frame
-  // with 200 well-separated objects near linear instead of 200^3.
-  const int rows = static_cast<int>(cost.rows());
-  const int cols = static_cast<int>(cost.cols());
+  // groups (objects far apart never compete), and each is solved on its own.
   std::vector<int> result(rows, -1);
   std::vector<int> parent(rows + cols);
   for (int i = 0; i < rows + cols; ++i) parent[i] = i;
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      if (!std::isfinite(cost(r, c))) continue;
-      const int a = findRoot(parent, r);
-      const int b = findRoot(parent, rows + c);
-      if (a != b) parent[a] = b;
+  for (const CostEntry& e : entries) {
+    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols || !std::isfinite(e.cost)) {
+      continue;
+    }
+    const int a = findRoot(parent, e.row);
+    const int b = findRoot(parent, rows + e.col);
+    if (a != b) parent[a] = b;
+  }
+  // Group members in index order, and each group's pairs.
+  std::vector<int> group_of(rows + cols);
+  std::vector<int> local(rows + cols, -1);
+  std::vector<int> group_rows_count(rows + cols, 0), group_cols_count(rows + cols, 0);
+  for (int i = 0; i < rows + cols; ++i) {
+    group_of[i] = findRoot(parent, i);
+    if (i < rows) {
+      local[i] = group_rows_count[group_of[i]]++;
+    } else {
+      local[i] = group_cols_count[group_of[i]]++;
     }
   }
-  std::vector<std::vector<int>> group_rows(rows + cols), group_cols(rows + cols);
-  for (int r = 0; r < rows; ++r) group_rows[findRoot(parent, r)].push_back(r);
-  for (int c = 0; c < cols; ++c) group_cols[findRoot(parent, rows + c)].push_back(c);
+  std::vector<std::vector<CostEntry>> group_entries(rows + cols);
+  for (const CostEntry& e : entries) {
+    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols || !std::isfinite(e.cost)) {
+      continue;
+    }
+    group_entries[group_of[e.row]].push_back({local[e.row], local[rows + e.col], e.cost});
+  }
+  std::vector<std::vector<int>> members_rows(rows + cols), members_cols(rows + cols);
+  for (int r = 0; r < rows; ++r) members_rows[group_of[r]].push_back(r);
+  for (int c = 0; c < cols; ++c) members_cols[group_of[rows + c]].push_back(c);
   for (int g = 0; g < rows + cols; ++g) {
-    const auto& gr = group_rows[g];
-    const auto& gc = group_cols[g];
+    const auto& gr = members_rows[g];
+    const auto& gc = members_cols[g];
     if (gr.empty() || gc.empty()) continue;
     if (gr.size() == 1 && gc.size() == 1) {
       result[gr[0]] = gc[0];  // linked, hence allowed
       continue;
     }
-    Eigen::MatrixXd sub(gr.size(), gc.size());
-    for (std::size_t i = 0; i < gr.size(); ++i) {
-      for (std::size_t j = 0; j < gc.size(); ++j) sub(i, j) = cost(gr[i], gc[j]);
-    }
+    Eigen::MatrixXd sub = Eigen::MatrixXd::Constant(
+        static_cast<Eigen::Index>(gr.size()), static_cast<Eigen::Index>(gc.size()), kForbidden);
+    for (const CostEntry& e : group_entries[g]) sub(e.row, e.col) = e.cost;
     const std::vector<int> match = solveDense(sub);
     for (std::size_t i = 0; i < gr.size(); ++i) {
       if (match[i] >= 0) result[gr[i]] = gc[match[i]];

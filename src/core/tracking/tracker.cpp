@@ -1,5 +1,6 @@
 #include "downstream_perception/core/tracking/tracker.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -181,13 +182,41 @@ struct Core : Tracker::Impl {
                         const std::vector<Mat>& R, std::vector<int>* det_of_track,
                         std::vector<int>* track_of_det) {
     if (cands.empty() || dets.empty()) return 0;
-    Eigen::MatrixXd c(cands.size(), dets.size());
-    for (std::size_t i = 0; i < cands.size(); ++i) {
+    std::vector<CostEntry> entries;
+    const auto consider = [&](std::size_t i, std::size_t j) {
+      const double c = cost(cands[i], all[dets[j]], z[dets[j]], R[dets[j]]);
+      if (std::isfinite(c)) {
+        entries.push_back({static_cast<int>(i), static_cast<int>(j), c});
+      }
+    };
+    if constexpr (D == 2) {
+      // Sweep and prune along x: a pair can pass the gate only if |dx| <= sqrt(gate *
+      // (lambda_max(P) + lambda_max(R))), so with tracks sorted by x each detection looks at the
+      // tracks within the largest such reach instead of all of them.
+      double max_lambda_r = 0.0;
+      for (const std::size_t j : dets) max_lambda_r = std::max(max_lambda_r, maxEigen(R[j]));
+      std::vector<std::pair<double, std::size_t>> by_x;
+      by_x.reserve(cands.size());
+      double reach = 0.0;
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        const State& s = states[cands[i]];
+        by_x.emplace_back(s.filter.position()(0), i);
+        reach = std::max(reach, std::sqrt(gate * (s.lambda_max + max_lambda_r)));
+      }
+      std::sort(by_x.begin(), by_x.end());
       for (std::size_t j = 0; j < dets.size(); ++j) {
-        c(i, j) = cost(cands[i], all[dets[j]], z[dets[j]], R[dets[j]]);
+        const double x = z[dets[j]](0);
+        auto it =
+            std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(x - reach, std::size_t{0}));
+        for (; it != by_x.end() && it->first <= x + reach; ++it) consider(it->second, j);
+      }
+    } else {
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        for (std::size_t j = 0; j < dets.size(); ++j) consider(i, j);
       }
     }
-    const std::vector<int> match = solveAssignment(c);
+    const std::vector<int> match =
+        solveAssignment(static_cast<int>(cands.size()), static_cast<int>(dets.size()), entries);
     std::size_t matched = 0;
     for (std::size_t i = 0; i < cands.size(); ++i) {
       if (match[i] < 0) continue;
