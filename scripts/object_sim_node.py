@@ -13,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 import rospy
 import tf2_ros
-from geometry_msgs.msg import TransformStamped
 from std_msgs.msg import Bool
 
 from downstream_perception.msg import DetectedObject, DetectedObjectArray
+from downstream_perception.ros_util import transform_stamped
 from downstream_perception.sim import ObjectScene, SceneConfig
 
 
@@ -72,13 +72,7 @@ def main() -> None:
         f = scene.step()
         stamp = t0 + rospy.Duration.from_sec(f.stamp)
         robot_x = robot_speed * f.stamp
-        t = TransformStamped()
-        t.header.stamp = stamp
-        t.header.frame_id = "odom"
-        t.child_frame_id = "base_link"
-        t.transform.translation.x = robot_x
-        t.transform.rotation.w = 1.0
-        tf.sendTransform(t)
+        tf.sendTransform(transform_stamped("odom", "base_link", stamp, x=robot_x))
         in_base = f.positions - np.array([robot_x, 0.0])
         detections.publish(
             detection_array(stamp, "base_link", in_base, f.scores, f.detection_truth, variance)

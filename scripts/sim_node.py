@@ -18,6 +18,7 @@ from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
 
+from downstream_perception.ros_util import transform_stamped
 from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive
 
 
@@ -29,17 +30,9 @@ def se2_matrix(x: float, y: float, yaw: float) -> np.ndarray:
 def to_transform(
     parent: str, child: str, m: np.ndarray, stamp: rospy.Time, z: float = 0.0
 ) -> TransformStamped:
-    t = TransformStamped()
-    t.header.frame_id = parent
-    t.header.stamp = stamp
-    t.child_frame_id = child
-    t.transform.translation.x = float(m[0, 2])
-    t.transform.translation.y = float(m[1, 2])
-    t.transform.translation.z = z
+    """parent <- child from a 3 x 3 SE(2) matrix."""
     yaw = math.atan2(m[1, 0], m[0, 0])
-    t.transform.rotation.z = math.sin(yaw / 2.0)
-    t.transform.rotation.w = math.cos(yaw / 2.0)
-    return t
+    return transform_stamped(parent, child, stamp, x=m[0, 2], y=m[1, 2], z=z, yaw=yaw)
 
 
 class SimNode:

@@ -25,6 +25,7 @@ class CostmapClient:
         self._info = None
         self._header = None
         self._grid: np.ndarray | None = None
+        self._last_full: np.ndarray | None = None
         self.full_grids = 0
         self.updates = 0
         self.last_change_wall = 0.0  # time.time() of the last full grid or update
@@ -36,6 +37,7 @@ class CostmapClient:
         with self._lock:
             self._info, self._header = msg.info, msg.header
             self._grid = grid.copy()
+            self._last_full = grid
             self.full_grids += 1
             self.last_change_wall = time.time()
 
@@ -59,6 +61,13 @@ class CostmapClient:
             if self._grid is None:
                 raise RuntimeError("no costmap received yet")
             return self._grid.copy()
+
+    def last_full_grid(self) -> np.ndarray:
+        """The last grid received whole on <topic> (without the updates since)."""
+        with self._lock:
+            if self._last_full is None:
+                raise RuntimeError("no costmap received yet")
+            return self._last_full.copy()
 
     def message(self) -> OccupancyGrid:
         """The current costmap as one nav_msgs/OccupancyGrid (as if sent in full)."""

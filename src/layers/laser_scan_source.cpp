@@ -92,7 +92,7 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
   const double sweep_s = msg->time_increment * static_cast<double>(msg->ranges.size() - 1);
   bool corrected = false;
   if (config_.per_beam_time_correction && sweep_s != 0.0 && msg->ranges.size() > 1) {
-    if (std::abs(sweep_s) > tolerance_.toSec() && sweep_s > 0.0) {
+    if (sweep_s > tolerance_.toSec()) {
       tolerance_ = ros::Duration(sweep_s);  // from now on wait for tf at the last beam too
       subscription_.setTolerance(tolerance_);
     }

@@ -75,11 +75,7 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
     grid_config_ = model;
-    if (!(grid_.config().p_hit == model.p_hit && grid_.config().p_miss == model.p_miss &&
-          grid_.config().clamp_min == model.clamp_min &&
-          grid_.config().clamp_max == model.clamp_max &&
-          grid_.config().occupied_threshold == model.occupied_threshold &&
-          grid_.config().free_threshold == model.free_threshold)) {
+    if (grid_.config() != model) {
       grid_.setConfig(model);  // thresholds may have moved: every state is re-read
     }
     config_ = layer;

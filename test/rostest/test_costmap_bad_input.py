@@ -12,21 +12,10 @@ import rospy
 import rostest
 import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import LaserScan
 
 from downstream_perception.costmap_client import CostmapClient
-
-
-def transform(parent: str, child: str, x: float, y: float, stamp: rospy.Time) -> TransformStamped:
-    t = TransformStamped()
-    t.header.frame_id = parent
-    t.header.stamp = stamp
-    t.child_frame_id = child
-    t.transform.translation.x = x
-    t.transform.translation.y = y
-    t.transform.rotation.w = 1.0
-    return t
+from downstream_perception.ros_util import transform_stamped, wait_until
 
 
 class BadInputTest(unittest.TestCase):
@@ -49,8 +38,8 @@ class BadInputTest(unittest.TestCase):
         now = rospy.Time.now()
         cls.static_tf.sendTransform(
             [
-                transform("map", "base_link", 0.0, 0.0, now),
-                transform("map", "laser", 0.05, 0.05, now),
+                transform_stamped("map", "base_link", now),
+                transform_stamped("map", "laser", now, x=0.05, y=0.05),
             ]
         )
         cls.tf = tf2_ros.TransformBroadcaster()
@@ -87,12 +76,7 @@ class BadInputTest(unittest.TestCase):
             time.sleep(0.05)
 
     def wait_for(self, predicate, timeout: float = 15.0) -> bool:  # type: ignore[no-untyped-def]
-        deadline = time.time() + timeout
-        while time.time() < deadline and not rospy.is_shutdown():
-            if predicate():
-                return True
-            time.sleep(0.1)
-        return False
+        return wait_until(predicate, timeout)
 
     def cell(self, key: str, x: float, y: float) -> int:
         return self.clients[key].cell(x, y)
@@ -133,9 +117,9 @@ class BadInputTest(unittest.TestCase):
             time.sleep(0.05)
         # Late tf: a frame whose only transform is 60 s newer than the scan (older than the cache).
         now = rospy.Time.now()
-        self.tf.sendTransform(transform("map", "late_laser", 0.0, 0.0, now))
+        self.tf.sendTransform(transform_stamped("map", "late_laser", now))
         time.sleep(0.3)
-        self.tf.sendTransform(transform("map", "late_laser", 0.0, 0.0, rospy.Time.now()))
+        self.tf.sendTransform(transform_stamped("map", "late_laser", rospy.Time.now()))
         self.pub.publish(self.scan([1.0] * 8, frame="late_laser", stamp=now - rospy.Duration(60.0)))
 
         self.assertTrue(self.wait_for(lambda: self.rejected("bad message") >= 4), self.layer())

@@ -10,6 +10,7 @@ name order and build on each other.
 
 from __future__ import annotations
 
+import functools
 import math
 import threading
 import time
@@ -19,27 +20,18 @@ import dynamic_reconfigure.client
 import numpy as np
 import rospy
 import rostest
-from geometry_msgs.msg import TransformStamped
-from map_msgs.msg import OccupancyGridUpdate
-from nav_msgs.msg import OccupancyGrid
 from sensor_msgs import point_cloud2
 from sensor_msgs.msg import LaserScan, PointCloud2
 from std_srvs.srv import Empty
 from tf2_ros import StaticTransformBroadcaster, TransformBroadcaster
 
+from downstream_perception import ros_util
+from downstream_perception.costmap_client import CostmapClient
+from downstream_perception.ros_util import transform_stamped
+
 WALL_X = 2.025  # a cell centre: no float rounding decides the cell
 N_BEAMS = 720
 CAMERA_Z = 0.5
-
-
-def transform(parent: str, child: str, x: float, y: float, z: float, stamp: rospy.Time):
-    t = TransformStamped()
-    t.header.stamp = stamp
-    t.header.frame_id = parent
-    t.child_frame_id = child
-    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
-    t.transform.rotation.w = 1.0
-    return t
 
 
 def scan_ranges(robot_x: float) -> np.ndarray:
@@ -68,8 +60,8 @@ class Robot:
         now = rospy.Time.now()
         self.static.sendTransform(
             [
-                transform("base_link", "laser", 0.0, 0.0, 0.0, now),
-                transform("base_link", "camera", 0.0, 0.0, CAMERA_Z, now),
+                transform_stamped("base_link", "laser", now),
+                transform_stamped("base_link", "camera", now, z=CAMERA_Z),
             ]
         )
         self.scan_pub = rospy.Publisher("/scan", LaserScan, queue_size=5)
@@ -84,7 +76,7 @@ class Robot:
             now = rospy.Time.now()
             with self.lock:
                 x, publishing = self.x, self.publishing
-            self.tf.sendTransform(transform("map", "base_link", x, 0.0, 0.0, now))
+            self.tf.sendTransform(transform_stamped("map", "base_link", now, x=x))
             if publishing and k % 2 == 1:
                 self._publish_scan(x, now)
                 self._publish_cloud(now)
@@ -124,67 +116,20 @@ class Robot:
             self.x = x
 
 
-class GridFollower:
-    """Keeps the latest full grid, and a copy rebuilt from full grids plus updates."""
-
-    def __init__(self, ns: str) -> None:
-        self.full: OccupancyGrid | None = None
-        self.rebuilt: np.ndarray | None = None
-        self.received = False
-        self.fulls = 0
-        self.updates = 0
-        self.lock = threading.Lock()
-        rospy.Subscriber(f"{ns}/costmap", OccupancyGrid, self._on_full, queue_size=10)
-        rospy.Subscriber(
-            f"{ns}/costmap_updates", OccupancyGridUpdate, self._on_update, queue_size=50
-        )
-
-    def _on_full(self, msg: OccupancyGrid) -> None:
-        with self.lock:
-            self.full = msg
-            self.fulls += 1
-            data = np.asarray(msg.data, dtype=np.int8)
-            self.rebuilt = data.reshape(msg.info.height, msg.info.width).copy()
-            self.received = True
-
-    def _on_update(self, msg: OccupancyGridUpdate) -> None:
-        with self.lock:
-            if self.rebuilt is None:
-                return
-            patch = np.asarray(msg.data, dtype=np.int8).reshape(msg.height, msg.width)
-            self.rebuilt[msg.y : msg.y + msg.height, msg.x : msg.x + msg.width] = patch
-            self.updates += 1
-
-    def grid(self) -> np.ndarray:
-        with self.lock:
-            assert self.rebuilt is not None, "no costmap received"
-            return self.rebuilt.copy()
-
-    def origin(self) -> tuple[float, float]:
-        with self.lock:
-            assert self.full is not None
-            return self.full.info.origin.position.x, self.full.info.origin.position.y
+# Every wait in this test allows 20 s.
+wait_until = functools.partial(ros_util.wait_until, timeout_s=20.0)
 
 
 def cell_value(grid: np.ndarray, origin: tuple[float, float], x: float, y: float) -> int:
     return int(grid[int((y - origin[1]) / 0.05), int((x - origin[0]) / 0.05)])
 
 
-def wait_until(predicate, timeout_s: float = 20.0) -> bool:
-    deadline = time.time() + timeout_s
-    while time.time() < deadline and not rospy.is_shutdown():
-        if predicate():
-            return True
-        time.sleep(0.1)
-    return predicate()
-
-
 class CostmapLiveTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls) -> None:
         rospy.init_node("test_costmap_live")
-        cls.live = GridFollower("/costmap_live")
-        cls.rolling = GridFollower("/costmap_rolling")
+        cls.live = CostmapClient("/costmap_live/costmap")
+        cls.rolling = CostmapClient("/costmap_rolling/costmap")
         cls.robot = Robot()
         cls.origin = (-5.0, -5.0)
 
@@ -193,7 +138,7 @@ class CostmapLiveTest(unittest.TestCase):
 
     def test_1_scan_wall_cloud_band_and_footprint_clearing(self) -> None:
         self.assertTrue(
-            wait_until(lambda: self.live.rebuilt is not None and self.lethal_at(WALL_X, 0.0)),
+            wait_until(lambda: self.live.received and self.lethal_at(WALL_X, 0.0)),
             f"the wall seen by the scan never became lethal; lethal cells at "
             f"{np.argwhere(self.live.grid() == 100)[:10].tolist() if self.live.received else None}",
         )
@@ -213,12 +158,13 @@ class CostmapLiveTest(unittest.TestCase):
         time.sleep(1.5)  # the last scans integrated and published as updates
         self.assertGreater(self.live.updates, 0, "no ~costmap_updates were published")
         rebuilt = self.live.grid()
-        fulls_before = self.live.fulls
+        fulls_before = self.live.full_grids
         client = dynamic_reconfigure.client.Client("/costmap_live", timeout=10)
         client.update_configuration({"always_send_full_costmap": True})
-        self.assertTrue(wait_until(lambda: self.live.fulls > fulls_before), "no full grid followed")
-        with self.live.lock:
-            full = np.asarray(self.live.full.data, dtype=np.int8).reshape(rebuilt.shape)
+        self.assertTrue(
+            wait_until(lambda: self.live.full_grids > fulls_before), "no full grid followed"
+        )
+        full = self.live.last_full_grid()
         np.testing.assert_array_equal(rebuilt, full)
         self.assertGreater(int(np.count_nonzero(full == 100)), 10)
         client.update_configuration({"always_send_full_costmap": False})
@@ -267,7 +213,7 @@ class CostmapLiveTest(unittest.TestCase):
     def test_6_rolling_window_follows_the_robot(self) -> None:
         self.robot.resume()
         self.assertTrue(
-            wait_until(lambda: self.rolling.full is not None and self.rolling.origin()[0] == -2.0)
+            wait_until(lambda: self.rolling.received and self.rolling.origin()[0] == -2.0)
         )
         for x in np.arange(0.05, 1.0001, 0.05):
             self.robot.move_to(float(x))

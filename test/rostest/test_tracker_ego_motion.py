@@ -19,11 +19,11 @@ import numpy as np
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import TransformStamped
 from tf2_ros import TransformBroadcaster
 from visualization_msgs.msg import Marker, MarkerArray
 
 from downstream_perception.msg import DetectedObject, DetectedObjectArray, TrackedObjectArray
+from downstream_perception.ros_util import transform_stamped, wait_until
 
 ROBOT_SPEED = 1.0  # m/s along odom x
 PARKED = np.array([[4.0, 1.5], [7.0, -1.0]])
@@ -47,13 +47,7 @@ class Scene:
             now = rospy.Time.now()
             t = (now - self.t0).to_sec()
             robot_x = ROBOT_SPEED * t
-            tf = TransformStamped()
-            tf.header.stamp = now
-            tf.header.frame_id = "odom"
-            tf.child_frame_id = "base_link"
-            tf.transform.translation.x = robot_x
-            tf.transform.rotation.w = 1.0
-            self.tf.sendTransform(tf)
+            self.tf.sendTransform(transform_stamped("odom", "base_link", now, x=robot_x))
             objects = [(k, PARKED[k]) for k in range(2)]
             if self.walker_visible:
                 objects.append((2, WALKER_START + WALKER_VELOCITY * t))
@@ -105,13 +99,8 @@ class TrackerEgoMotionTest(unittest.TestCase):
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
         cls.scene = Scene()
 
-    def wait_for(self, predicate, timeout_s: float = 15.0) -> bool:
-        deadline = time.time() + timeout_s
-        while time.time() < deadline and not rospy.is_shutdown():
-            if predicate():
-                return True
-            time.sleep(0.1)
-        return predicate()
+    def wait_for(self, predicate, timeout_s: float = 15.0) -> bool:  # type: ignore[no-untyped-def]
+        return wait_until(predicate, timeout_s)
 
     def confirmed(self) -> list:
         if not self.history:

@@ -27,6 +27,12 @@ struct LogOddsConfig {
 
   /// Empty if valid, else a message naming the offending field and value.
   std::string validate() const;
+  bool operator==(const LogOddsConfig& o) const {
+    return p_hit == o.p_hit && p_miss == o.p_miss && clamp_min == o.clamp_min &&
+           clamp_max == o.clamp_max && occupied_threshold == o.occupied_threshold &&
+           free_threshold == o.free_threshold;
+  }
+  bool operator!=(const LogOddsConfig& o) const { return !(*this == o); }
 };
 
 enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 1 };

@@ -69,9 +69,19 @@ bool validDetection(const Detection& d, TrackerConfig::Mode mode) {
 
 // ------------------------------------------------------------------------------------------
 struct Tracker::Impl {
-  explicit Impl(const TrackerConfig& c) : config(c) {
+  explicit Impl(const TrackerConfig& c) { setConfig(c); }
+  void setConfig(const TrackerConfig& c) {
+    config = c;
     gate = chiSquareQuantile(2, c.gate_confidence);
     duplicate_gate = chiSquareQuantile(2, c.duplicate_confidence);
+  }
+  /// ID-switch bookkeeping against truth ids. As MOT metrics do, only tracks that are reported
+  /// (confirmed) can switch identity.
+  void noteTruth(const Detection& d, const Track& track, TrackerStats* stats) {
+    if (d.truth_id < 0 || track.state != TrackState::kConfirmed) return;
+    auto it = track_of_truth.find(d.truth_id);
+    if (it != track_of_truth.end() && it->second != track.id) ++stats->id_switches;
+    track_of_truth[d.truth_id] = track.id;
   }
   virtual ~Impl() = default;
   virtual TrackerStats step(double stamp_s, const std::vector<Detection>& detections) = 0;
@@ -376,12 +386,7 @@ struct Core : Tracker::Impl {
         }
         track.truth_id = d.truth_id;
         assignment[j] = track.id;
-        // As MOT metrics do: only tracks that are reported (confirmed) can switch identity.
-        if (d.truth_id >= 0 && track.state == TrackState::kConfirmed) {
-          auto it = track_of_truth.find(d.truth_id);
-          if (it != track_of_truth.end() && it->second != track.id) ++stats.id_switches;
-          track_of_truth[d.truth_id] = track.id;
-        }
+        noteTruth(d, track, &stats);
       } else if (track.state == TrackState::kTentative ||
                  now - s.last_update_s > config.max_age_s) {
         ++stats.deaths;
@@ -417,11 +422,7 @@ struct Core : Tracker::Impl {
       tracks.push_back(track);
       states.push_back(s);
       assignment[j] = track.id;
-      if (d.truth_id >= 0 && track.state == TrackState::kConfirmed) {
-        auto it = track_of_truth.find(d.truth_id);
-        if (it != track_of_truth.end() && it->second != track.id) ++stats.id_switches;
-        track_of_truth[d.truth_id] = track.id;
-      }
+      noteTruth(d, track, &stats);
       ++stats.births;
     }
     for (std::size_t t = 0; t < tracks.size(); ++t) refresh(t, now);
@@ -469,9 +470,7 @@ void Tracker::setConfig(const TrackerConfig& config) {
   if (config.mode != impl_->config.mode) {
     throw std::invalid_argument("tracker: the mode cannot change on a running tracker");
   }
-  impl_->config = config;
-  impl_->gate = chiSquareQuantile(2, config.gate_confidence);
-  impl_->duplicate_gate = chiSquareQuantile(2, config.duplicate_confidence);
+  impl_->setConfig(config);
 }
 
 }  // namespace downstream_perception
