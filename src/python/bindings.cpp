@@ -492,6 +492,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("mode", &TrackerConfig::mode)
       .def_readwrite("gate_confidence", &TrackerConfig::gate_confidence)
       .def_readwrite("duplicate_confidence", &TrackerConfig::duplicate_confidence)
+      .def_readwrite("reid_confidence", &TrackerConfig::reid_confidence)
       .def_readwrite("min_iou", &TrackerConfig::min_iou)
       .def_readwrite("accel_psd", &TrackerConfig::accel_psd)
       .def_readwrite("measurement_std", &TrackerConfig::measurement_std)
@@ -512,6 +513,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("births", &TrackerStats::births)
       .def_readonly("deaths", &TrackerStats::deaths)
       .def_readonly("duplicates_removed", &TrackerStats::duplicates_removed)
+      .def_readonly("reidentified", &TrackerStats::reidentified)
       .def_readonly("id_switches", &TrackerStats::id_switches)
       .def_readonly("tracks", &TrackerStats::tracks)
       .def_readonly("confirmed", &TrackerStats::confirmed);

@@ -83,6 +83,7 @@ void TrackerRos::reconfigure(TrackerNodeConfig& c, std::uint32_t) {
   TrackerConfig next = tracker_->config();
   next.gate_confidence = c.gate_confidence;
   next.duplicate_confidence = c.duplicate_confidence;
+  next.reid_confidence = c.reid_confidence;
   next.min_iou = c.min_iou;
   next.accel_psd = c.accel_psd;
   next.measurement_std = c.measurement_std;
@@ -253,6 +254,7 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("matched first pass (total)", total_.matched_first_pass);
   status.add("matched second pass (total)", total_.matched_second_pass);
   status.add("duplicates removed (total)", total_.duplicates_removed);
+  status.add("re-identified after a gap (total)", total_.reidentified);
   status.add("deaths (total)", total_.deaths);
   status.add("ID switches vs truth ids (total)", total_.id_switches);
   status.add("step time mean (us)", step_us_.mean());

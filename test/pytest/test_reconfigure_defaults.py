@@ -54,3 +54,21 @@ def test_cfg_names_are_yaml_keys() -> None:
     }
     assert set(CostmapConfig.defaults) == expected
     assert CostmapConfig.defaults["robot_radius"] == 0.46  # costmap_2d's default
+
+
+def test_tracker_defaults_match_tracker_config_and_yaml() -> None:
+    from pathlib import Path
+
+    import yaml
+
+    from downstream_perception.cfg import TrackerNodeConfig
+
+    d = TrackerNodeConfig.defaults
+    c = dp.TrackerConfig()
+    assert d, "no tracker parameters generated"
+    for name, value in d.items():
+        assert getattr(c, name) == pytest.approx(value), name
+    # cfg/tracker.yaml documents every live parameter with the same default.
+    documented = yaml.safe_load((Path(__file__).parents[2] / "cfg" / "tracker.yaml").read_text())
+    for name, value in d.items():
+        assert documented[name] == pytest.approx(value), name

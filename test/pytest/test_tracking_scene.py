@@ -6,7 +6,8 @@ per frame, 10 % of true detections with a low score. Scored two ways, as in the 
 "visible" (ground truth only while visible, confirmed tracks only) and "all" (occluded objects
 count; coasting tracks are reported, which is what a planner wants).
 The anchors (abewley/sort and ByteTrack tuned on a comparable scene, N = 30): MOTA 0.88 / IDF1
-0.80-0.82 / 32-73 ID switches per 30 s visible, MOTA 0.75 all.
+0.80-0.82 / 32-73 ID switches per 30 s visible, MOTA 0.75 all. Seeds 0-2 have been the scoring
+seeds since the scene was written; the README also reports seeds 0-10.
 """
 
 from __future__ import annotations
@@ -58,32 +59,27 @@ def score(seed: int, config: dp.TrackerConfig, frames: int = 300) -> dict[str, f
     }
 
 
-def tuned() -> dp.TrackerConfig:
-    """Tuned for this scene (as the anchors were for theirs)."""
-    config = dp.TrackerConfig()
-    config.accel_psd = 0.2
-    config.max_age_s = 2.0
-    config.gate_confidence = 0.9999
-    return config
-
-
-def test_tracker_scores_on_the_simulated_scene() -> None:
-    results = [score(seed, tuned()) for seed in range(3)]
+def test_tracker_defaults_meet_the_goals_on_the_simulated_scene() -> None:
+    results = [score(seed, dp.TrackerConfig()) for seed in range(3)]
     mean = {k: float(np.mean([r[k] for r in results])) for k in results[0]}
     print(mean)  # shown with pytest -s
-    # Issue 4's goals that are met: MOTA >= 0.90 visible, >= 0.85 with occluded objects counted.
+    # Issue 4's goals, with the defaults (no tuning for the scene): MOTA >= 0.90, IDF1 >= 0.90,
+    # <= 10 ID switches per 30 s (visible objects), MOTA >= 0.85 with occluded objects counted.
     assert mean["mota"] >= 0.90
+    assert mean["idf1"] >= 0.90
+    assert mean["switches"] <= 10
     assert mean["mota_all"] >= 0.85
-    # Not yet at the goals (IDF1 >= 0.90, <= 10 switches per 30 s); measured 0.898 and 15:
-    # these guard against regressions until then.
-    assert mean["idf1"] >= 0.87
-    assert mean["switches"] <= 20
 
 
-def test_defaults_are_reasonable_without_tuning() -> None:
-    result = score(0, dp.TrackerConfig())
-    assert result["mota"] >= 0.88
-    assert result["mota_all"] >= 0.85
+def test_second_pass_pays_off() -> None:
+    # ByteTrack's idea on this scene (10 % of true detections have a low score): without the
+    # second pass those frames are misses (measured MOTA 0.84 instead of 0.93 on seed 1).
+    base = score(1, dp.TrackerConfig())
+    no_second = dp.TrackerConfig()
+    no_second.second_pass = False
+    without = score(1, no_second)
+    assert without["mota"] < base["mota"]
+    assert without["idf1_all"] <= base["idf1_all"]
 
 
 def test_scene_generator_is_reproducible_and_has_ground_truth() -> None:

@@ -92,10 +92,12 @@ class TrackerSceneTest(unittest.TestCase):
         v = metrics.compute(visible, metrics=["mota", "idf1", "num_switches"], name="v").iloc[0]
         a = metrics.compute(everything, metrics=["mota", "idf1"], name="a").iloc[0]
         rospy.loginfo("tracker scene: visible %s, all %s", v.to_dict(), a.to_dict())
-        # Defaults (no tuning) through ROS: the same bars as the core's default-config pytest.
-        self.assertGreaterEqual(v["mota"], 0.88)
-        self.assertGreaterEqual(a["mota"], 0.85)
-        self.assertGreaterEqual(v["idf1"], 0.75)
+        # Defaults (no tuning) through ROS, one seed (measured MOTA 0.927, IDF1 0.912, 11
+        # switches, MOTA 0.949 all): bars a little below, as tf timing may differ per run.
+        self.assertGreaterEqual(v["mota"], 0.90)
+        self.assertGreaterEqual(v["idf1"], 0.87)
+        self.assertLessEqual(v["num_switches"], 20)
+        self.assertGreaterEqual(a["mota"], 0.90)
 
 
 if __name__ == "__main__":

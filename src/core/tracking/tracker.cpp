@@ -16,6 +16,8 @@ std::string TrackerConfig::validate() const {
     why << "gate_confidence must be in (0, 1), got " << gate_confidence;
   } else if (!(duplicate_confidence > 0.0 && duplicate_confidence < 1.0)) {
     why << "duplicate_confidence must be in (0, 1), got " << duplicate_confidence;
+  } else if (!(reid_confidence > 0.0 && reid_confidence < 1.0)) {
+    why << "reid_confidence must be in (0, 1), got " << reid_confidence;
   } else if (!(min_iou >= 0.0 && min_iou <= 1.0)) {
     why << "min_iou must be in [0, 1], got " << min_iou;
   } else if (!positive(accel_psd)) {
@@ -43,6 +45,7 @@ void TrackerStats::accumulate(const TrackerStats& o) {
   unmatched_outside_gate += o.unmatched_outside_gate;
   births += o.births;
   duplicates_removed += o.duplicates_removed;
+  reidentified += o.reidentified;
   deaths += o.deaths;
   id_switches += o.id_switches;
   tracks = o.tracks;
@@ -74,14 +77,15 @@ struct Tracker::Impl {
     config = c;
     gate = chiSquareQuantile(2, c.gate_confidence);
     duplicate_gate = chiSquareQuantile(2, c.duplicate_confidence);
+    reid_gate = chiSquareQuantile(2, c.reid_confidence);
   }
   /// ID-switch bookkeeping against truth ids. As MOT metrics do, only tracks that are reported
   /// (confirmed) can switch identity.
-  void noteTruth(const Detection& d, const Track& track, TrackerStats* stats) {
-    if (d.truth_id < 0 || track.state != TrackState::kConfirmed) return;
-    auto it = track_of_truth.find(d.truth_id);
+  void noteTruth(const Track& track, TrackerStats* stats) {
+    if (track.truth_id < 0 || track.state != TrackState::kConfirmed) return;
+    auto it = track_of_truth.find(track.truth_id);
     if (it != track_of_truth.end() && it->second != track.id) ++stats->id_switches;
-    track_of_truth[d.truth_id] = track.id;
+    track_of_truth[track.truth_id] = track.id;
   }
   virtual ~Impl() = default;
   virtual TrackerStats step(double stamp_s, const std::vector<Detection>& detections) = 0;
@@ -90,6 +94,7 @@ struct Tracker::Impl {
   TrackerConfig config;
   double gate = 9.21;
   double duplicate_gate = 4.61;
+  double reid_gate = 23.0;
   std::vector<Track> tracks;
   std::vector<std::uint64_t> assignment;
   std::uint64_t next_id = 1;
@@ -111,6 +116,7 @@ struct Core : Tracker::Impl {
     double birth_s = 0.0;
     double last_update_s = 0.0;
     double lambda_max = 0.0;  ///< largest eigenvalue of the position covariance (metric gate)
+    int detection = -1;       ///< index of this frame's detection, -1 if none
   };
 
   // Largest eigenvalue of a symmetric 2 x 2 matrix (closed form); unused for D = 4.
@@ -177,7 +183,7 @@ struct Core : Tracker::Impl {
       if (!(det > 0.0)) return kForbidden;
       const double d2 =
           (S(1, 1) * r(0) * r(0) - (S(0, 1) + S(1, 0)) * r(0) * r(1) + S(0, 0) * r(1) * r(1)) / det;
-      return d2 <= gate ? d2 : kForbidden;
+      return d2 <= gate ? d2 + std::log(det) : kForbidden;
     } else {
       (void)z, (void)R;
       const Vec p = states[t].filter.position();
@@ -237,37 +243,86 @@ struct Core : Tracker::Impl {
     return matched;
   }
 
-  // Two established tracks on one object (one born while the other coasted just outside its
-  // gate) would take turns with its detections forever. When a track that got no detection
-  // this frame sits within the duplicate gate of one that did (squared Mahalanobis distance of
-  // their positions under the sum of their covariances), the coasting one goes. Two tracks
-  // that both took detections are two objects, however close.
-  std::size_t removeDuplicates() {
-    const double limit = duplicate_gate;
-    std::vector<char> gone(tracks.size(), 0);
-    std::size_t removed = 0;
-    for (std::size_t a = 0; a < tracks.size(); ++a) {
-      if (gone[a] || tracks[a].state == TrackState::kTentative) continue;
-      const Vec pa = states[a].filter.position();
-      const Mat ca = states[a].filter.positionCov();
-      const double la = maxEigen(ca);
-      for (std::size_t b = a + 1; b < tracks.size(); ++b) {
-        if (gone[b] || tracks[b].state == TrackState::kTentative) continue;
-        const bool a_coasts = tracks[a].state == TrackState::kCoasting;
-        const bool b_coasts = tracks[b].state == TrackState::kCoasting;
-        if (a_coasts == b_coasts) continue;  // both seen (two objects) or both unseen
-        const Vec r = states[b].filter.position() - pa;
-        const double lb = maxEigen(states[b].filter.positionCov());
-        if (r.squaredNorm() > limit * (la + lb)) continue;
-        const Mat S = ca + states[b].filter.positionCov();
-        if (r.dot(S.ldlt().solve(r)) > limit) continue;
-        const std::size_t loser = a_coasts ? a : b;
-        gone[loser] = 1;
-        ++removed;
-        if (loser == a) break;
+  // A confirmed track that coasted (occlusion, misses) may come back as a new track born from
+  // a detection just outside its gate. When that newcomer is confirmed, it takes the coasting
+  // track's id (and history) if their positions agree within the re-identification gate
+  // (squared Mahalanobis distance under the sum of both covariances). Only tracks that were
+  // already coasting when the newcomer was born qualify: a track that was updated meanwhile
+  // follows another object. Pairs are chosen by one global assignment.
+  std::size_t reidentify(const std::vector<std::size_t>& newcomers, std::vector<char>* gone) {
+    if (newcomers.empty()) return 0;
+    std::vector<std::size_t> lost;
+    for (std::size_t t = 0; t < tracks.size(); ++t) {
+      if (tracks[t].state == TrackState::kCoasting) lost.push_back(t);
+    }
+    if (lost.empty()) return 0;
+    std::vector<CostEntry> entries;
+    for (std::size_t i = 0; i < newcomers.size(); ++i) {
+      const std::size_t n = newcomers[i];
+      for (std::size_t k = 0; k < lost.size(); ++k) {
+        const std::size_t o = lost[k];
+        if (states[o].last_update_s > states[n].birth_s) continue;
+        if (config.class_aware && tracks[n].class_id >= 0 && tracks[o].class_id >= 0 &&
+            tracks[n].class_id != tracks[o].class_id) {
+          continue;
+        }
+        const double d2 = pairDistance2(n, o);
+        if (d2 <= reid_gate) entries.push_back({static_cast<int>(i), static_cast<int>(k), d2});
       }
     }
-    if (removed == 0) return 0;
+    const std::vector<int> match = solveAssignment(static_cast<int>(newcomers.size()),
+                                                   static_cast<int>(lost.size()), entries);
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < newcomers.size(); ++i) {
+      if (match[i] < 0) continue;
+      Track& young = tracks[newcomers[i]];
+      const std::size_t o = lost[match[i]];
+      young.id = tracks[o].id;
+      young.hits += tracks[o].hits;
+      if (young.class_id < 0) young.class_id = tracks[o].class_id;
+      states[newcomers[i]].birth_s = states[o].birth_s;
+      (*gone)[o] = 1;
+      ++count;
+    }
+    return count;
+  }
+
+  // Squared Mahalanobis distance between two tracks' positions under the sum of covariances.
+  double pairDistance2(std::size_t a, std::size_t b) const {
+    const Vec r = states[b].filter.position() - states[a].filter.position();
+    const Mat S = states[a].filter.positionCov() + states[b].filter.positionCov();
+    return r.dot(S.ldlt().solve(r));
+  }
+
+  // Two established tracks on one object (one born while the other coasted, and not
+  // re-identified) would take turns with its detections. When a coasting track sits within the
+  // duplicate gate of a track that took a detection this frame and was born while the coasting
+  // one was already coasting, the coasting one goes. Two tracks that both took detections are
+  // two objects, however close, and so is a coasting track next to an older one (an object
+  // walking behind another keeps its track).
+  std::size_t removeDuplicates(std::vector<char>* gone, double now) {
+    const double limit = duplicate_gate;
+    std::size_t removed = 0;
+    for (std::size_t a = 0; a < tracks.size(); ++a) {
+      if ((*gone)[a] || tracks[a].state != TrackState::kCoasting) continue;
+      for (std::size_t b = 0; b < tracks.size(); ++b) {
+        if ((*gone)[b] || tracks[b].state == TrackState::kTentative) continue;
+        if (states[b].last_update_s != now || states[b].birth_s < states[a].last_update_s) {
+          continue;
+        }
+        const Vec r = states[b].filter.position() - states[a].filter.position();
+        if (r.squaredNorm() > limit * (states[a].lambda_max + states[b].lambda_max)) continue;
+        if (pairDistance2(a, b) > limit) continue;
+        (*gone)[a] = 1;
+        ++removed;
+        break;
+      }
+    }
+    return removed;
+  }
+
+  // Drops the tracks marked gone (order kept).
+  void compact(const std::vector<char>& gone) {
     std::size_t out = 0;
     for (std::size_t t = 0; t < tracks.size(); ++t) {
       if (gone[t]) continue;
@@ -277,7 +332,6 @@ struct Core : Tracker::Impl {
     }
     tracks.resize(out);
     states.resize(out);
-    return removed;
   }
 
   void refresh(std::size_t t, double now) {
@@ -311,6 +365,7 @@ struct Core : Tracker::Impl {
     stats.detections = detections.size();
 
     for (State& s : states) {
+      s.detection = -1;
       s.filter.predict(dt, processNoise(s));
       if constexpr (D == 2) s.lambda_max = maxEigen(s.filter.positionCov());
     }
@@ -364,7 +419,7 @@ struct Core : Tracker::Impl {
     std::vector<State> kept_states;
     kept_tracks.reserve(tracks.size() + high.size());
     kept_states.reserve(tracks.size() + high.size());
-    assignment.assign(detections.size(), 0);
+    std::vector<std::size_t> newcomers;  // confirmed this frame (indices into kept_tracks)
     for (std::size_t t = 0; t < tracks.size(); ++t) {
       Track& track = tracks[t];
       State& s = states[t];
@@ -373,6 +428,7 @@ struct Core : Tracker::Impl {
         const Detection& d = detections[j];
         s.filter.update(z[j], R[j]);
         s.last_update_s = now;
+        s.detection = j;
         ++track.hits;
         track.score = d.score;
         if constexpr (D == 2) {
@@ -380,13 +436,13 @@ struct Core : Tracker::Impl {
           track.size_y = d.size_y;
         }
         if (track.class_id < 0) track.class_id = d.class_id;
-        if (track.state == TrackState::kCoasting ||
-            (track.state == TrackState::kTentative && track.hits >= config.min_hits)) {
+        if (track.state == TrackState::kTentative && track.hits >= config.min_hits) {
+          newcomers.push_back(kept_tracks.size());
+          track.state = TrackState::kConfirmed;
+        } else if (track.state == TrackState::kCoasting) {
           track.state = TrackState::kConfirmed;
         }
         track.truth_id = d.truth_id;
-        assignment[j] = track.id;
-        noteTruth(d, track, &stats);
       } else if (track.state == TrackState::kTentative ||
                  now - s.last_update_s > config.max_age_s) {
         ++stats.deaths;
@@ -399,7 +455,12 @@ struct Core : Tracker::Impl {
     }
     tracks.swap(kept_tracks);
     states.swap(kept_states);
-    if constexpr (D == 2) stats.duplicates_removed = removeDuplicates();
+    if constexpr (D == 2) {
+      std::vector<char> gone(tracks.size(), 0);
+      stats.reidentified = reidentify(newcomers, &gone);
+      stats.duplicates_removed = removeDuplicates(&gone, now);
+      compact(gone);
+    }
     stats.deaths += stats.duplicates_removed;
 
     // Births from unmatched high-score detections.
@@ -419,11 +480,18 @@ struct Core : Tracker::Impl {
       double velocity_std = config.initial_velocity_std;
       if constexpr (D == 4) velocity_std *= d.box.height();
       State s{Filter(z[j], R[j], velocity_std), now, now};
+      s.detection = static_cast<int>(j);
       tracks.push_back(track);
       states.push_back(s);
-      assignment[j] = track.id;
-      noteTruth(d, track, &stats);
       ++stats.births;
+    }
+    // Ids are final now (re-identification may have changed some).
+    assignment.assign(detections.size(), 0);
+    for (std::size_t t = 0; t < tracks.size(); ++t) {
+      const int j = states[t].detection;
+      if (j < 0) continue;
+      assignment[j] = tracks[t].id;
+      noteTruth(tracks[t], &stats);
     }
     for (std::size_t t = 0; t < tracks.size(); ++t) refresh(t, now);
     stats.tracks = tracks.size();
