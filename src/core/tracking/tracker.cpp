@@ -270,8 +270,8 @@ struct Core : Tracker::Impl {
         if (d2 <= reid_gate) entries.push_back({static_cast<int>(i), static_cast<int>(k), d2});
       }
     }
-    const std::vector<int> match = solveAssignment(static_cast<int>(newcomers.size()),
-                                                   static_cast<int>(lost.size()), entries);
+    const std::vector<int> match =
+        solveAssignment(static_cast<int>(newcomers.size()), static_cast<int>(lost.size()), entries);
     std::size_t count = 0;
     for (std::size_t i = 0; i < newcomers.size(); ++i) {
       if (match[i] < 0) continue;
