@@ -109,7 +109,7 @@ struct TrackerStats {
   std::size_t deaths = 0;  ///< includes duplicates removed
   std::size_t duplicates_removed = 0;
   std::size_t reidentified = 0;  ///< new tracks that took a coasting track's id
-  std::size_t id_switches = 0;  ///< truth objects whose track id changed (needs truth ids)
+  std::size_t id_switches = 0;   ///< truth objects whose track id changed (needs truth ids)
   std::size_t tracks = 0;
   std::size_t confirmed = 0;
   void accumulate(const TrackerStats& o);
