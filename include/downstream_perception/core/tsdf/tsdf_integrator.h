@@ -1,0 +1,50 @@
+// Fusing depth images (projective) and point clouds (along each ray) into a TsdfMap.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <vector>
+
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+
+namespace downstream_perception {
+
+/// Pinhole intrinsics of a depth image in the ROS optical convention (z forward, x right,
+/// y down; pixel (u, v) has its centre at integer coordinates, as in CameraInfo's K).
+struct PinholeCamera {
+  double fx = 0.0;
+  double fy = 0.0;
+  double cx = 0.0;
+  double cy = 0.0;
+  int width = 0;
+  int height = 0;
+  /// Empty if valid, else the reason.
+  std::string validate() const;
+};
+
+struct TsdfIntegrationStats {
+  std::size_t pixels_valid = 0;      ///< depths (or points) used
+  std::size_t pixels_invalid = 0;    ///< NaN, 0, negative or outside [min_depth_m, max_depth_m]
+  std::size_t pixels_no_return = 0;  ///< +Inf (REP-118: nothing within range)
+  std::size_t blocks_touched = 0;
+  std::size_t blocks_allocated = 0;
+  std::size_t blocks_refused = 0;  ///< not allocated: max_blocks reached
+  std::size_t blocks_evicted = 0;  ///< farther than max_block_distance_m
+  std::size_t voxels_updated = 0;
+};
+
+/// Integrates a depth image: `depth` holds width * height depths in metres along the optical
+/// axis (row-major; NaN, 0 or negative = invalid, +Inf = no return). T_map_camera takes
+/// optical-frame points into the map frame. Each voxel in the touched blocks is projected to its
+/// nearest pixel centre (rounding, not truncation: no half-pixel bias) and updated with
+/// sdf = (depth - z) * |(x/z, y/z, 1)|: the range difference along the ray through the voxel.
+TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const PinholeCamera& camera,
+                                    const Eigen::Isometry3d& T_map_camera);
+
+/// Integrates points (map frame) seen from `origin` (map frame): each voxel the ray crosses
+/// within mu of its end point is updated with the signed distance along the ray.
+TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vector3d>& points,
+                                     const Eigen::Vector3d& origin);
+
+}  // namespace downstream_perception

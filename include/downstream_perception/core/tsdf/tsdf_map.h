@@ -1,0 +1,133 @@
+// Sparse truncated signed-distance field: voxel blocks of 8^3 in a hash map keyed by block
+// index, allocated only where observations put the truncation band.
+//
+// Voxel i (integer 3-vector) has its centre at i * voxel_size_m in the map frame, so voxel
+// centres are the lattice points marching cubes interpolates between. Each voxel holds the
+// normalised signed distance D = clamp(sdf / mu, -1, 1) (positive in front of the surface, in
+// free space) and the fusion weight W, updated by the weighted running average
+// D <- (W D + w d) / (W + w), W <- min(W + w, max_weight) (Curless & Levoy 1996).
+#pragma once
+
+#include <tsl/robin_map.h>
+#include <Eigen/Core>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace downstream_perception {
+
+struct TsdfConfig {
+  double voxel_size_m = 0.02;
+  /// Truncation distance mu in voxels (mu = truncation_voxels * voxel_size_m); 3-5 is usual.
+  double truncation_voxels = 4.0;
+  /// Cap on the fused weight, so the map keeps following a changing scene (0 = no cap).
+  double max_weight = 100.0;
+  enum class Weighting {
+    kConstant,           ///< w = 1 per observation (Open3D, KinectFusion)
+    kInverseSquareDepth  ///< w = 1 / z^2 (z in m): far, noisier depths count less
+  };
+  Weighting weighting = Weighting::kConstant;
+  /// Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at -mu, so a
+  /// surface seen from one side does not write a deep negative shell that ghosts when seen from
+  /// the other side (voxblox's weight drop-off).
+  bool behind_surface_dropoff = true;
+  /// Depth images: read each voxel's depth by interpolating inverse depth between the four
+  /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
+  /// nearest pixel across depth edges (neighbours differing by more than one voxel).
+  bool interpolate_depth = true;
+  double min_depth_m = 0.1;   ///< closer depths are invalid
+  double max_depth_m = 10.0;  ///< farther depths are invalid
+  /// Voxels whose weight is below this are "unobserved" for meshing and queries.
+  double min_weight = 1e-3;
+  std::size_t max_blocks = 200000;  ///< hard cap: new blocks beyond it are not allocated
+  /// Blocks whose centre is farther than this from the last sensor origin are evicted after each
+  /// integration (0 = never).
+  double max_block_distance_m = 0.0;
+
+  double truncation() const { return truncation_voxels * voxel_size_m; }
+  /// Empty if valid, else the reason.
+  std::string validate() const;
+};
+
+struct TsdfVoxel {
+  float distance = 0.0f;  ///< normalised signed distance D in [-1, 1]
+  float weight = 0.0f;
+};
+
+constexpr int kTsdfBlockSide = 8;
+constexpr int kTsdfBlockVoxels = kTsdfBlockSide * kTsdfBlockSide * kTsdfBlockSide;
+
+struct TsdfBlock {
+  std::array<TsdfVoxel, kTsdfBlockVoxels> voxels{};
+  std::uint64_t updated_stamp = 0;  ///< map generation of the last integration that touched it
+  static int linear(int x, int y, int z) { return x + kTsdfBlockSide * (y + kTsdfBlockSide * z); }
+};
+
+struct BlockIndexHash {
+  std::size_t operator()(const Eigen::Vector3i& k) const {
+    // Large primes (Teschner et al. 2003), the voxel-hashing standard.
+    return static_cast<std::size_t>(static_cast<std::int64_t>(k.x()) * 73856093 ^
+                                    static_cast<std::int64_t>(k.y()) * 19349669 ^
+                                    static_cast<std::int64_t>(k.z()) * 83492791);
+  }
+};
+
+class TsdfMap {
+ public:
+  using BlockMap = tsl::robin_map<Eigen::Vector3i, std::unique_ptr<TsdfBlock>, BlockIndexHash>;
+
+  /// Throws std::invalid_argument if the config is invalid.
+  explicit TsdfMap(const TsdfConfig& config = {});
+
+  const TsdfConfig& config() const { return config_; }
+  double voxelSize() const { return config_.voxel_size_m; }
+
+  /// Block containing voxel `voxel`, and the voxel's index inside it.
+  static Eigen::Vector3i blockOf(const Eigen::Vector3i& voxel);
+  static int localIndex(const Eigen::Vector3i& voxel);
+  /// Nearest voxel to a point (m).
+  Eigen::Vector3i voxelAt(const Eigen::Vector3d& p) const;
+  Eigen::Vector3d voxelCenter(const Eigen::Vector3i& voxel) const {
+    return voxel.cast<double>() * config_.voxel_size_m;
+  }
+
+  /// The block, created if missing (nullptr when max_blocks is reached).
+  TsdfBlock* allocate(const Eigen::Vector3i& block);
+  TsdfBlock* find(const Eigen::Vector3i& block);
+  const TsdfBlock* find(const Eigen::Vector3i& block) const;
+  /// The voxel if its block exists, else nullptr.
+  const TsdfVoxel* voxel(const Eigen::Vector3i& voxel) const;
+
+  /// Fuses one observation (normalised distance d, weight w) into a voxel.
+  void fuse(TsdfVoxel* v, float d, float w) const {
+    const float total = v->weight + w;
+    v->distance = (v->weight * v->distance + w * d) / total;
+    v->weight = max_weight_ > 0.0f && total > max_weight_ ? max_weight_ : total;
+  }
+
+  /// Removes blocks whose centre is farther than `distance_m` from `center`; returns how many.
+  std::size_t evictFartherThan(const Eigen::Vector3d& center, double distance_m);
+  void clear();
+
+  const BlockMap& blocks() const { return blocks_; }
+  std::size_t blockCount() const { return blocks_.size(); }
+  /// Bytes held by the blocks and the hash table.
+  std::size_t memoryBytes() const;
+
+  /// Incremented by each integration; blocks record the generation that last touched them, so a
+  /// mesher can re-extract only blocks changed since its last pass.
+  std::uint64_t generation() const { return generation_; }
+  std::uint64_t beginIntegration() { return ++generation_; }
+
+ private:
+  TsdfConfig config_;
+  float max_weight_ = 0.0f;
+  BlockMap blocks_;
+  std::uint64_t generation_ = 0;
+};
+
+}  // namespace downstream_perception

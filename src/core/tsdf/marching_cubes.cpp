@@ -1,0 +1,309 @@
+#include "downstream_perception/core/tsdf/marching_cubes.h"
+
+#include <tsl/robin_set.h>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+namespace downstream_perception {
+
+const std::array<std::array<int, 3>, 8> kCubeCorners = {
+    {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
+const std::array<std::array<int, 2>, 12> kCubeEdges = {{{0, 1},
+                                                        {1, 2},
+                                                        {2, 3},
+                                                        {3, 0},
+                                                        {4, 5},
+                                                        {5, 6},
+                                                        {6, 7},
+                                                        {7, 4},
+                                                        {0, 4},
+                                                        {1, 5},
+                                                        {2, 6},
+                                                        {3, 7}}};
+
+namespace {
+
+// Each face as its corners in cyclic order and the edges between consecutive corners
+// (edge k joins corner k and corner k + 1 of the cycle).
+struct Face {
+  std::array<int, 4> corners;
+  std::array<int, 4> edges;
+};
+constexpr std::array<Face, 6> kFaces = {{{{0, 1, 2, 3}, {0, 1, 2, 3}},
+                                         {{4, 5, 6, 7}, {4, 5, 6, 7}},
+                                         {{0, 1, 5, 4}, {0, 9, 4, 8}},
+                                         {{1, 2, 6, 5}, {1, 10, 5, 9}},
+                                         {{2, 3, 7, 6}, {2, 11, 6, 10}},
+                                         {{3, 0, 4, 7}, {3, 8, 7, 11}}}};
+
+Eigen::Vector3d edgeMidpoint(int e) {
+  const auto& a = kCubeCorners[kCubeEdges[e][0]];
+  const auto& b = kCubeCorners[kCubeEdges[e][1]];
+  return 0.5 * Eigen::Vector3d(a[0] + b[0], a[1] + b[1], a[2] + b[2]);
+}
+
+std::vector<std::array<int, 3>> deriveCase(int mask) {
+  const auto inside = [mask](int c) { return ((mask >> c) & 1) != 0; };
+  // Segment neighbours of each crossing edge (one per face it lies on).
+  std::array<std::vector<int>, 12> links;
+  for (const Face& f : kFaces) {
+    std::vector<int> crossing;  // positions k in the face cycle whose edge crosses
+    for (int k = 0; k < 4; ++k) {
+      if (inside(f.corners[k]) != inside(f.corners[(k + 1) % 4])) crossing.push_back(k);
+    }
+    const auto link = [&](int ka, int kb) {
+      links[f.edges[ka]].push_back(f.edges[kb]);
+      links[f.edges[kb]].push_back(f.edges[ka]);
+    };
+    if (crossing.size() == 2) {
+      link(crossing[0], crossing[1]);
+    } else if (crossing.size() == 4) {
+      // Ambiguous face: cut off each inside corner (edges k-1 and k meet at corner k).
+      for (int k = 0; k < 4; ++k) {
+        if (inside(f.corners[k])) link((k + 3) % 4, k);
+      }
+    }
+  }
+  std::vector<std::array<int, 3>> triangles;
+  std::array<bool, 12> used{};
+  for (int start = 0; start < 12; ++start) {
+    if (used[start] || links[start].empty()) continue;
+    std::vector<int> loop = {start};
+    used[start] = true;
+    int previous = -1, current = start;
+    while (true) {
+      const int next = links[current][0] != previous ? links[current][0] : links[current][1];
+      if (next == start) break;
+      loop.push_back(next);
+      used[next] = true;
+      previous = current;
+      current = next;
+    }
+    // Orientation: the loop's Newell normal must point from inside corners to outside ones.
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero(), toward_free = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const Eigen::Vector3d a = edgeMidpoint(loop[i]);
+      const Eigen::Vector3d b = edgeMidpoint(loop[(i + 1) % loop.size()]);
+      normal += a.cross(b);
+      const auto& e = kCubeEdges[loop[i]];
+      const int out = inside(e[0]) ? e[1] : e[0];
+      const int in = inside(e[0]) ? e[0] : e[1];
+      for (int k = 0; k < 3; ++k) toward_free(k) += kCubeCorners[out][k] - kCubeCorners[in][k];
+    }
+    if (normal.dot(toward_free) < 0.0) std::reverse(loop.begin(), loop.end());
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+      triangles.push_back({loop[0], loop[i], loop[i + 1]});
+    }
+  }
+  return triangles;
+}
+
+// The block's cube corners (lattice 0 .. 8 per axis) plus the border their gradients read
+// (-1 and 9), gathered from the 27 blocks around it once, so the loops index an array.
+constexpr int kPad = kTsdfBlockSide + 3;
+struct Neighbourhood {
+  std::array<const TsdfVoxel*, kPad * kPad * kPad> voxels{};
+  static int at(int x, int y, int z) { return (x + 1) + kPad * ((y + 1) + kPad * (z + 1)); }
+};
+
+void gather(const TsdfMap& map, const Eigen::Vector3i& block, Neighbourhood* n) {
+  std::array<const TsdfBlock*, 27> around{};
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        around[(dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1))] =
+            map.find(block + Eigen::Vector3i(dx, dy, dz));
+      }
+    }
+  }
+  const auto split = [](int a, int* offset, int* local) {
+    *offset = a < 0 ? -1 : (a >= kTsdfBlockSide ? 1 : 0);
+    *local = a - *offset * kTsdfBlockSide;
+  };
+  for (int z = -1; z <= kTsdfBlockSide + 1; ++z) {
+    int oz, lz;
+    split(z, &oz, &lz);
+    for (int y = -1; y <= kTsdfBlockSide + 1; ++y) {
+      int oy, ly;
+      split(y, &oy, &ly);
+      for (int x = -1; x <= kTsdfBlockSide + 1; ++x) {
+        int ox, lx;
+        split(x, &ox, &lx);
+        const TsdfBlock* b = around[(ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1))];
+        n->voxels[Neighbourhood::at(x, y, z)] =
+            b == nullptr ? nullptr : &b->voxels[TsdfBlock::linear(lx, ly, lz)];
+      }
+    }
+  }
+}
+
+}  // namespace
+
+const std::vector<std::array<int, 3>>& marchingCubesCase(int inside_mask) {
+  static const std::vector<std::vector<std::array<int, 3>>> table = [] {
+    std::vector<std::vector<std::array<int, 3>>> t(256);
+    for (int mask = 0; mask < 256; ++mask) t[mask] = deriveCase(mask);
+    return t;
+  }();
+  return table[inside_mask & 255];
+}
+
+void TriangleMesh::append(const TriangleMesh& other) {
+  const auto offset = static_cast<std::uint32_t>(vertices.size());
+  vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
+  normals.insert(normals.end(), other.normals.begin(), other.normals.end());
+  triangles.reserve(triangles.size() + other.triangles.size());
+  for (const std::uint32_t i : other.triangles) triangles.push_back(i + offset);
+}
+
+std::string TriangleMesh::writePly(const std::string& path) const {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) return "cannot open " + path + " for writing";
+  out << "ply\nformat binary_little_endian 1.0\ncomment downstream_perception TSDF mesh (m)\n"
+      << "element vertex " << vertices.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "property float nx\nproperty float ny\nproperty float nz\n"
+      << "element face " << triangleCount() << "\nproperty list uchar uint vertex_indices\n"
+      << "end_header\n";
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    out.write(reinterpret_cast<const char*>(vertices[i].data()), 3 * sizeof(float));
+    out.write(reinterpret_cast<const char*>(normals[i].data()), 3 * sizeof(float));
+  }
+  const unsigned char three = 3;
+  for (std::size_t t = 0; t < triangleCount(); ++t) {
+    out.write(reinterpret_cast<const char*>(&three), 1);
+    out.write(reinterpret_cast<const char*>(&triangles[3 * t]), 3 * sizeof(std::uint32_t));
+  }
+  out.flush();
+  return out ? std::string() : "write to " + path + " failed";
+}
+
+TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) {
+  TriangleMesh mesh;
+  const float min_weight = static_cast<float>(map.config().min_weight);
+  Neighbourhood n;
+  gather(map, block, &n);
+  const auto observed = [&](int x, int y, int z) {
+    const TsdfVoxel* v = n.voxels[Neighbourhood::at(x, y, z)];
+    return v != nullptr && v->weight > min_weight ? v : nullptr;
+  };
+  // Gradient of D (per voxel) by central differences, one-sided where a neighbour is missing.
+  const auto gradient = [&](int x, int y, int z) {
+    Eigen::Vector3f g = Eigen::Vector3f::Zero();
+    const std::array<int, 3> p = {x, y, z};
+    for (int a = 0; a < 3; ++a) {
+      std::array<int, 3> lo = p, hi = p;
+      --lo[a];
+      ++hi[a];
+      const TsdfVoxel* vl = observed(lo[0], lo[1], lo[2]);
+      const TsdfVoxel* vh = observed(hi[0], hi[1], hi[2]);
+      const TsdfVoxel* vc = observed(x, y, z);
+      if (vl != nullptr && vh != nullptr) {
+        g(a) = 0.5f * (vh->distance - vl->distance);
+      } else if (vh != nullptr && vc != nullptr) {
+        g(a) = vh->distance - vc->distance;
+      } else if (vl != nullptr && vc != nullptr) {
+        g(a) = vc->distance - vl->distance;
+      }
+    }
+    return g;
+  };
+  // Vertex of each lattice edge (corner lattice index * 3 + axis), shared within the block.
+  constexpr int kLattice = kTsdfBlockSide + 1;
+  std::vector<std::int32_t> vertex_of_edge(kLattice * kLattice * kLattice * 3, -1);
+  const double s = map.voxelSize();
+  const Eigen::Vector3i origin = block * kTsdfBlockSide;
+  for (int z = 0; z < kTsdfBlockSide; ++z) {
+    for (int y = 0; y < kTsdfBlockSide; ++y) {
+      for (int x = 0; x < kTsdfBlockSide; ++x) {
+        std::array<const TsdfVoxel*, 8> corner;
+        int mask = 0;
+        bool complete = true;
+        for (int c = 0; c < 8 && complete; ++c) {
+          const auto& o = kCubeCorners[c];
+          corner[c] = observed(x + o[0], y + o[1], z + o[2]);
+          complete = corner[c] != nullptr;
+          if (complete && corner[c]->distance < 0.0f) mask |= 1 << c;
+        }
+        if (!complete || mask == 0 || mask == 255) continue;
+        for (const auto& tri : marchingCubesCase(mask)) {
+          std::array<std::uint32_t, 3> ids;
+          for (int k = 0; k < 3; ++k) {
+            const int e = tri[k];
+            const auto& ca = kCubeCorners[kCubeEdges[e][0]];
+            const auto& cb = kCubeCorners[kCubeEdges[e][1]];
+            // Canonical lattice edge: lower corner + axis.
+            const std::array<int, 3> a = {x + ca[0], y + ca[1], z + ca[2]};
+            const std::array<int, 3> b = {x + cb[0], y + cb[1], z + cb[2]};
+            const std::array<int, 3> lo = {std::min(a[0], b[0]), std::min(a[1], b[1]),
+                                           std::min(a[2], b[2])};
+            const int axis = a[0] != b[0] ? 0 : (a[1] != b[1] ? 1 : 2);
+            const int key = ((lo[0] + kLattice * (lo[1] + kLattice * lo[2])) * 3) + axis;
+            if (vertex_of_edge[key] < 0) {
+              const float da = corner[kCubeEdges[e][0]]->distance;
+              const float db = corner[kCubeEdges[e][1]]->distance;
+              const float t = da / (da - db);
+              const Eigen::Vector3f pa(a[0], a[1], a[2]), pb(b[0], b[1], b[2]);
+              const Eigen::Vector3f local = pa + t * (pb - pa);
+              vertex_of_edge[key] = static_cast<std::int32_t>(mesh.vertices.size());
+              mesh.vertices.push_back(
+                  ((origin.cast<float>() + local) * static_cast<float>(s)).eval());
+              Eigen::Vector3f g =
+                  (1.0f - t) * gradient(a[0], a[1], a[2]) + t * gradient(b[0], b[1], b[2]);
+              const float norm = g.norm();
+              mesh.normals.push_back(norm > 0.0f ? (g / norm).eval() : Eigen::Vector3f::UnitZ());
+            }
+            ids[k] = static_cast<std::uint32_t>(vertex_of_edge[key]);
+          }
+          // Degenerate triangles (a crossing exactly on a shared corner) are dropped.
+          if (ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2]) continue;
+          mesh.triangles.insert(mesh.triangles.end(), ids.begin(), ids.end());
+        }
+      }
+    }
+  }
+  return mesh;
+}
+
+std::size_t TsdfMesher::update(const TsdfMap& map) {
+  last_updated_.clear();
+  for (auto it = meshes_.begin(); it != meshes_.end();) {
+    it = map.find(it->first) == nullptr ? meshes_.erase(it) : std::next(it);
+  }
+  tsl::robin_set<Eigen::Vector3i, BlockIndexHash> dirty;
+  for (const auto& [key, block] : map.blocks()) {
+    if (block->updated_stamp <= last_generation_ && meshes_.count(key) != 0) continue;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i k = key + Eigen::Vector3i(dx, dy, dz);
+          if (map.find(k) != nullptr) dirty.insert(k);
+        }
+      }
+    }
+  }
+  for (const Eigen::Vector3i& key : dirty) {
+    meshes_[key] = extractBlockMesh(map, key);
+    last_updated_.push_back(key);
+  }
+  last_generation_ = map.generation();
+  return dirty.size();
+}
+
+TriangleMesh TsdfMesher::combined() const {
+  TriangleMesh all;
+  for (const auto& [key, mesh] : meshes_) all.append(mesh);
+  return all;
+}
+
+void TsdfMesher::clear() {
+  meshes_.clear();
+  last_generation_ = 0;
+  last_updated_.clear();
+}
+
+}  // namespace downstream_perception

@@ -1,0 +1,109 @@
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace downstream_perception {
+
+std::string TsdfConfig::validate() const {
+  std::ostringstream why;
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(voxel_size_m) || voxel_size_m < 1e-3 || voxel_size_m > 10.0) {
+    why << "voxel_size_m must be in [0.001, 10] m, got " << voxel_size_m;
+  } else if (!(truncation_voxels >= 1.0 && truncation_voxels <= 64.0)) {
+    why << "truncation_voxels must be in [1, 64], got " << truncation_voxels;
+  } else if (!(std::isfinite(max_weight) && max_weight >= 0.0)) {
+    why << "max_weight must be finite and >= 0 (0 = no cap), got " << max_weight;
+  } else if (!(positive(min_depth_m) && std::isfinite(max_depth_m) && max_depth_m > min_depth_m)) {
+    why << "need 0 < min_depth_m < max_depth_m, got " << min_depth_m << " and " << max_depth_m;
+  } else if (!(std::isfinite(min_weight) && min_weight >= 0.0)) {
+    why << "min_weight must be finite and >= 0, got " << min_weight;
+  } else if (max_blocks < 1) {
+    why << "max_blocks must be >= 1";
+  } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {
+    why << "max_block_distance_m must be finite and >= 0 (0 = never evict), got "
+        << max_block_distance_m;
+  }
+  return why.str();
+}
+
+TsdfMap::TsdfMap(const TsdfConfig& config) : config_(config) {
+  const std::string why = config.validate();
+  if (!why.empty()) throw std::invalid_argument("tsdf: " + why);
+  max_weight_ = static_cast<float>(config.max_weight);
+}
+
+namespace {
+int floorDiv(int a, int b) {
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+}  // namespace
+
+Eigen::Vector3i TsdfMap::blockOf(const Eigen::Vector3i& v) {
+  return {floorDiv(v.x(), kTsdfBlockSide), floorDiv(v.y(), kTsdfBlockSide),
+          floorDiv(v.z(), kTsdfBlockSide)};
+}
+
+int TsdfMap::localIndex(const Eigen::Vector3i& v) {
+  const auto local = [](int a) { return a - floorDiv(a, kTsdfBlockSide) * kTsdfBlockSide; };
+  return TsdfBlock::linear(local(v.x()), local(v.y()), local(v.z()));
+}
+
+Eigen::Vector3i TsdfMap::voxelAt(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d s = p / config_.voxel_size_m;
+  return {static_cast<int>(std::lround(s.x())), static_cast<int>(std::lround(s.y())),
+          static_cast<int>(std::lround(s.z()))};
+}
+
+TsdfBlock* TsdfMap::allocate(const Eigen::Vector3i& block) {
+  auto it = blocks_.find(block);
+  if (it != blocks_.end()) return it->second.get();
+  if (blocks_.size() >= config_.max_blocks) return nullptr;
+  return blocks_.emplace(block, std::make_unique<TsdfBlock>()).first->second.get();
+}
+
+TsdfBlock* TsdfMap::find(const Eigen::Vector3i& block) {
+  auto it = blocks_.find(block);
+  return it == blocks_.end() ? nullptr : it->second.get();
+}
+
+const TsdfBlock* TsdfMap::find(const Eigen::Vector3i& block) const {
+  auto it = blocks_.find(block);
+  return it == blocks_.end() ? nullptr : it->second.get();
+}
+
+const TsdfVoxel* TsdfMap::voxel(const Eigen::Vector3i& v) const {
+  const TsdfBlock* b = find(blockOf(v));
+  return b == nullptr ? nullptr : &b->voxels[localIndex(v)];
+}
+
+std::size_t TsdfMap::evictFartherThan(const Eigen::Vector3d& center, double distance_m) {
+  const double block_m = kTsdfBlockSide * config_.voxel_size_m;
+  const double limit2 = distance_m * distance_m;
+  std::size_t removed = 0;
+  for (auto it = blocks_.begin(); it != blocks_.end();) {
+    const Eigen::Vector3d c =
+        (it->first.cast<double>() + Eigen::Vector3d::Constant(0.5)) * block_m -
+        Eigen::Vector3d::Constant(0.5 * config_.voxel_size_m);
+    if ((c - center).squaredNorm() > limit2) {
+      it = blocks_.erase(it);
+      ++removed;
+    } else {
+      ++it;
+    }
+  }
+  return removed;
+}
+
+void TsdfMap::clear() {
+  blocks_.clear();
+  ++generation_;
+}
+
+std::size_t TsdfMap::memoryBytes() const {
+  return blocks_.size() * sizeof(TsdfBlock) +
+         blocks_.bucket_count() * (sizeof(Eigen::Vector3i) + sizeof(void*) + sizeof(std::int32_t));
+}
+
+}  // namespace downstream_perception
