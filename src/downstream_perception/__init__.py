@@ -21,7 +21,32 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
+
+def numpy_abi_problem(numpy_version: str, pybind11_version: tuple[int, int]) -> str | None:
+    """Why the compiled core cannot work with this numpy, or None.
+
+    pybind11 before 2.12 reads numpy's array descriptors with numpy 1's layout; under numpy 2
+    its arrays come out silently wrong (every row a copy of the first), so refuse instead.
+    Debian 12 ships pybind11 2.10 and numpy 1.24: run with Debian's python3.
+    """
+    if int(numpy_version.split(".")[0]) >= 2 and tuple(pybind11_version) < (2, 12):
+        return (
+            f"the compiled core was built with pybind11 {pybind11_version[0]}."
+            f"{pybind11_version[1]}, which cannot exchange arrays with numpy {numpy_version} "
+            "(needs pybind11 >= 2.12); use Debian's /usr/bin/python3 (numpy 1.x) or a venv "
+            "with numpy<2"
+        )
+    return None
+
+
 try:
+    from downstream_perception import _core
+
+    _problem = numpy_abi_problem(np.__version__, tuple(_core.pybind11_version))
+    if _problem is not None:
+        raise ImportError(_problem)
     from downstream_perception._core import (  # noqa: F401
         FREE_SPACE,
         INSCRIBED_INFLATED_OBSTACLE,
@@ -68,9 +93,13 @@ except ImportError as error:  # the pure-Python parts (sim) stay usable without 
 
 def __getattr__(name: str) -> Any:
     if _CORE_IMPORT_ERROR is not None:
+        hint = (
+            " Build it with `make build` and `source .ws/devel/setup.bash`."
+            if isinstance(_CORE_IMPORT_ERROR, ModuleNotFoundError)
+            else ""
+        )
         raise ImportError(
             f"downstream_perception.{name} needs the compiled core, which did not import "
-            f"({_CORE_IMPORT_ERROR}). Build it with `make build` and "
-            "`source .ws/devel/setup.bash`."
+            f"({_CORE_IMPORT_ERROR}).{hint}"
         ) from _CORE_IMPORT_ERROR
     raise AttributeError(f"module 'downstream_perception' has no attribute {name!r}")

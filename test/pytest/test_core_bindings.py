@@ -164,3 +164,13 @@ def test_occupancy_table() -> None:
     table = dp.occupancy_table()
     assert (table[0], table[253], table[254], table[255]) == (0, 99, 100, -1)
     assert np.all(np.diff(table[1:253].astype(int)) >= 0)
+
+
+def test_numpy_abi_guard() -> None:
+    # pybind11 < 2.12 and numpy 2 give silently wrong arrays: the package refuses that pairing.
+    from downstream_perception import numpy_abi_problem
+
+    assert numpy_abi_problem("1.24.2", (2, 10)) is None
+    assert numpy_abi_problem("2.1.0", (2, 12)) is None
+    problem = numpy_abi_problem("2.4.6", (2, 10))
+    assert problem is not None and "pybind11 2.10" in problem and "numpy 2.4.6" in problem
