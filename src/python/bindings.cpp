@@ -25,6 +25,8 @@
 namespace py = pybind11;
 using namespace downstream_perception;  // NOLINT
 
+void bindTsdf(py::module& m);  // bind_tsdf.cpp
+
 namespace {
 
 py::array_t<int> cellsToArray(const std::vector<CellIndex>& cells) {
@@ -61,6 +63,7 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "downstream_perception ROS-free core (C++), with numpy arrays in and out.";
   // The package refuses numpy 2 with a pybind11 older than 2.12 (see __init__.py).
   m.attr("pybind11_version") = py::make_tuple(PYBIND11_VERSION_MAJOR, PYBIND11_VERSION_MINOR);
+  bindTsdf(m);
 
   // ----------------------------------------------------------------- grid geometry
   py::class_<GridGeometry>(m, "GridGeometry",

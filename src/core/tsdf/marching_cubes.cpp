@@ -46,56 +46,83 @@ Eigen::Vector3d edgeMidpoint(int e) {
   return 0.5 * Eigen::Vector3d(a[0] + b[0], a[1] + b[1], a[2] + b[2]);
 }
 
+bool shareFace(int ea, int eb) {
+  for (const Face& f : kFaces) {
+    const bool a = std::find(f.edges.begin(), f.edges.end(), ea) != f.edges.end();
+    const bool b = std::find(f.edges.begin(), f.edges.end(), eb) != f.edges.end();
+    if (a && b) return true;
+  }
+  return false;
+}
+
+Eigen::Vector3d cornerPoint(int c) {
+  return {double(kCubeCorners[c][0]), double(kCubeCorners[c][1]), double(kCubeCorners[c][2])};
+}
+
 std::vector<std::array<int, 3>> deriveCase(int mask) {
   const auto inside = [mask](int c) { return ((mask >> c) & 1) != 0; };
-  // Segment neighbours of each crossing edge (one per face it lies on).
-  std::array<std::vector<int>, 12> links;
+  // One directed segment per face per crossing pair: walking from edge a to edge b, the
+  // inside corner it cuts off lies to the side (b - a) x n_out points to (n_out: the face's
+  // outward normal). A neighbouring cube sees the face with the opposite normal, so it walks
+  // the same segment the other way: the surface is closed and consistently oriented by
+  // construction, with triangle normals toward the outside corners (free space).
+  std::array<int, 12> next;
+  next.fill(-1);
   for (const Face& f : kFaces) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const int c : f.corners) centre += 0.25 * cornerPoint(c);
+    const Eigen::Vector3d n_out = centre - Eigen::Vector3d::Constant(0.5);
+    const auto segment = [&](int ka, int kb, int inside_corner) {
+      const int ea = f.edges[ka], eb = f.edges[kb];
+      const Eigen::Vector3d pa = edgeMidpoint(ea), pb = edgeMidpoint(eb);
+      const Eigen::Vector3d side = (pb - pa).cross(n_out);
+      const bool forward = side.dot(cornerPoint(inside_corner) - 0.5 * (pa + pb)) > 0.0;
+      next[forward ? ea : eb] = forward ? eb : ea;
+    };
     std::vector<int> crossing;  // positions k in the face cycle whose edge crosses
     for (int k = 0; k < 4; ++k) {
       if (inside(f.corners[k]) != inside(f.corners[(k + 1) % 4])) crossing.push_back(k);
     }
-    const auto link = [&](int ka, int kb) {
-      links[f.edges[ka]].push_back(f.edges[kb]);
-      links[f.edges[kb]].push_back(f.edges[ka]);
-    };
     if (crossing.size() == 2) {
-      link(crossing[0], crossing[1]);
+      int in = -1;
+      for (const int c : f.corners) {
+        if (inside(c)) in = c;
+      }
+      segment(crossing[0], crossing[1], in);
     } else if (crossing.size() == 4) {
       // Ambiguous face: cut off each inside corner (edges k-1 and k meet at corner k).
       for (int k = 0; k < 4; ++k) {
-        if (inside(f.corners[k])) link((k + 3) % 4, k);
+        if (inside(f.corners[k])) segment((k + 3) % 4, k, f.corners[k]);
       }
     }
   }
   std::vector<std::array<int, 3>> triangles;
   std::array<bool, 12> used{};
   for (int start = 0; start < 12; ++start) {
-    if (used[start] || links[start].empty()) continue;
-    std::vector<int> loop = {start};
-    used[start] = true;
-    int previous = -1, current = start;
-    while (true) {
-      const int next = links[current][0] != previous ? links[current][0] : links[current][1];
-      if (next == start) break;
-      loop.push_back(next);
-      used[next] = true;
-      previous = current;
-      current = next;
+    if (used[start] || next[start] < 0) continue;
+    std::vector<int> loop;
+    for (int e = start; !used[e]; e = next[e]) {
+      used[e] = true;
+      loop.push_back(e);
     }
-    // Orientation: the loop's Newell normal must point from inside corners to outside ones.
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero(), toward_free = Eigen::Vector3d::Zero();
-    for (std::size_t i = 0; i < loop.size(); ++i) {
-      const Eigen::Vector3d a = edgeMidpoint(loop[i]);
-      const Eigen::Vector3d b = edgeMidpoint(loop[(i + 1) % loop.size()]);
-      normal += a.cross(b);
-      const auto& e = kCubeEdges[loop[i]];
-      const int out = inside(e[0]) ? e[1] : e[0];
-      const int in = inside(e[0]) ? e[0] : e[1];
-      for (int k = 0; k < 3; ++k) toward_free(k) += kCubeCorners[out][k] - kCubeCorners[in][k];
+    // Fan from an apex none of whose diagonals lies on a cube face: such a diagonal would be
+    // shared with the neighbouring cube's triangles (a non-manifold edge on ambiguous faces).
+    // Every loop of the 256 cases has one (a pinched edge would fail the random-field test).
+    const std::size_t n = loop.size();
+    std::size_t apex = 0;
+    for (std::size_t i = 0; i < n && n > 3; ++i) {
+      bool clean = true;
+      for (std::size_t j = 0; j < n && clean; ++j) {
+        if (j == i || j == (i + 1) % n || j == (i + n - 1) % n) continue;
+        clean = !shareFace(loop[i], loop[j]);
+      }
+      if (clean) {
+        apex = i;
+        break;
+      }
     }
-    if (normal.dot(toward_free) < 0.0) std::reverse(loop.begin(), loop.end());
-    for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+    std::rotate(loop.begin(), loop.begin() + static_cast<std::ptrdiff_t>(apex), loop.end());
+    for (std::size_t i = 1; i + 1 < n; ++i) {
       triangles.push_back({loop[0], loop[i], loop[i + 1]});
     }
   }
@@ -244,16 +271,21 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
             const int axis = a[0] != b[0] ? 0 : (a[1] != b[1] ? 1 : 2);
             const int key = ((lo[0] + kLattice * (lo[1] + kLattice * lo[2])) * 3) + axis;
             if (vertex_of_edge[key] < 0) {
-              const float da = corner[kCubeEdges[e][0]]->distance;
-              const float db = corner[kCubeEdges[e][1]]->distance;
-              const float t = da / (da - db);
-              const Eigen::Vector3f pa(a[0], a[1], a[2]), pb(b[0], b[1], b[2]);
-              const Eigen::Vector3f local = pa + t * (pb - pa);
+              // Interpolate from the lower lattice end, so the cubes (and blocks) sharing this
+              // edge compute bit-identical vertices: no hairline cracks on block seams.
+              const bool a_low = a == lo;
+              const std::array<int, 3>& low = a_low ? a : b;
+              const std::array<int, 3>& high = a_low ? b : a;
+              const float d_low = corner[kCubeEdges[e][a_low ? 0 : 1]]->distance;
+              const float d_high = corner[kCubeEdges[e][a_low ? 1 : 0]]->distance;
+              const float t = d_low / (d_low - d_high);
+              Eigen::Vector3f global((origin.x() + low[0]), (origin.y() + low[1]),
+                                     (origin.z() + low[2]));
+              global(axis) += t;
               vertex_of_edge[key] = static_cast<std::int32_t>(mesh.vertices.size());
-              mesh.vertices.push_back(
-                  ((origin.cast<float>() + local) * static_cast<float>(s)).eval());
-              Eigen::Vector3f g =
-                  (1.0f - t) * gradient(a[0], a[1], a[2]) + t * gradient(b[0], b[1], b[2]);
+              mesh.vertices.push_back(global * static_cast<float>(s));
+              Eigen::Vector3f g = (1.0f - t) * gradient(low[0], low[1], low[2]) +
+                                  t * gradient(high[0], high[1], high[2]);
               const float norm = g.norm();
               mesh.normals.push_back(norm > 0.0f ? (g / norm).eval() : Eigen::Vector3f::UnitZ());
             }

@@ -41,25 +41,116 @@ Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
           static_cast<int>(std::floor(std::floor(q.z()) / kTsdfBlockSide))};
 }
 
+// A depth image checked once per frame: depth (m; NaN invalid, +Inf no return) and inverse
+// depth (1/m; 0 where not a finite valid depth), so the per-voxel loop does no validation and no
+// division for interpolation.
+struct DepthFrame {
+  std::vector<float> depth;
+  std::vector<float> inverse;
+  std::vector<float> range_per_depth;  ///< |(x/z, y/z, 1)| of each pixel's ray
+  float min_depth = std::numeric_limits<float>::infinity();
+};
+
+DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfConfig& c,
+                   TsdfIntegrationStats* stats) {
+  DepthFrame f;
+  const std::size_t n = static_cast<std::size_t>(camera.width) * camera.height;
+  f.depth.resize(n);
+  f.inverse.resize(n);
+  f.range_per_depth.resize(n);
+  for (int v = 0; v < camera.height; ++v) {
+    const double y = (v - camera.cy) / camera.fy;
+    for (int u = 0; u < camera.width; ++u) {
+      const double x = (u - camera.cx) / camera.fx;
+      f.range_per_depth[static_cast<std::size_t>(v) * camera.width + u] =
+          static_cast<float>(std::sqrt(1.0 + x * x + y * y));
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const float d = depth[i];
+    if (std::isinf(d) && d > 0.0f) {
+      ++stats->pixels_no_return;
+      f.depth[i] = d;
+      f.inverse[i] = 0.0f;
+    } else if (d >= c.min_depth_m && d <= c.max_depth_m) {
+      ++stats->pixels_valid;
+      f.depth[i] = d;
+      f.inverse[i] = 1.0f / d;
+      f.min_depth = std::min(f.min_depth, d);
+    } else {
+      ++stats->pixels_invalid;
+      f.depth[i] = std::numeric_limits<float>::quiet_NaN();
+      f.inverse[i] = 0.0f;
+    }
+  }
+  return f;
+}
+
 /// Depth at a sub-pixel position: inverse depth interpolated bilinearly between the four
 /// surrounding pixel centres (exact on planes, where 1/z is affine in the image), or `nearest`
-/// when a neighbour is invalid or the four differ by more than `max_step` (a depth edge:
-/// interpolating there would put surface in free space).
-float interpolatedDepth(const float* depth, int w, int h, double uf, double vf, float nearest,
+/// when a neighbour is not a valid depth or the four differ by more than `max_step` (a depth
+/// edge: interpolating there would put surface in free space).
+float interpolatedDepth(const DepthFrame& f, int w, int h, double uf, double vf, float nearest,
                         float max_step) {
-  const int u0 = static_cast<int>(std::floor(uf));
-  const int v0 = static_cast<int>(std::floor(vf));
-  if (u0 < 0 || v0 < 0 || u0 + 1 >= w || v0 + 1 >= h) return nearest;
-  const float* row0 = depth + static_cast<std::size_t>(v0) * w + u0;
-  const float* row1 = row0 + w;
-  const float d00 = row0[0], d10 = row0[1], d01 = row1[0], d11 = row1[1];
-  const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
-  const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
-  // NaN fails both comparisons; +Inf fails the step test.
-  if (!(lo > 0.0f) || !(hi - lo <= max_step)) return nearest;
+  if (uf < 0.0 || vf < 0.0) return nearest;
+  const int u0 = static_cast<int>(uf);
+  const int v0 = static_cast<int>(vf);
+  if (u0 + 1 >= w || v0 + 1 >= h) return nearest;
+  const std::size_t i = static_cast<std::size_t>(v0) * w + u0;
+  const float* inv = f.inverse.data() + i;
+  const float i00 = inv[0], i10 = inv[1], i01 = inv[w], i11 = inv[w + 1];
+  if (i00 == 0.0f || i10 == 0.0f || i01 == 0.0f || i11 == 0.0f) return nearest;
+  const float* d = f.depth.data() + i;
+  const float lo = std::min(std::min(d[0], d[1]), std::min(d[w], d[w + 1]));
+  const float hi = std::max(std::max(d[0], d[1]), std::max(d[w], d[w + 1]));
+  if (hi - lo > max_step) return nearest;
   const float a = static_cast<float>(uf - u0), b = static_cast<float>(vf - v0);
-  const float inv = (1.0f - b) * ((1.0f - a) / d00 + a / d10) + b * ((1.0f - a) / d01 + a / d11);
-  return 1.0f / inv;
+  return 1.0f / ((1.0f - b) * ((1.0f - a) * i00 + a * i10) + b * ((1.0f - a) * i01 + a * i11));
+}
+
+/// Blocks the truncation band of the valid pixels passes through. Pixels are sampled every
+/// `stride` pixels, where a stride spans at most one voxel at the nearest depth of the frame
+/// (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the same
+/// block, so a one-entry cache skips most hash lookups.
+tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(const DepthFrame& f,
+                                                           const PinholeCamera& camera,
+                                                           const Eigen::Isometry3d& T,
+                                                           const TsdfConfig& c) {
+  tsl::robin_set<Eigen::Vector3i, BlockIndexHash> keys;
+  if (!std::isfinite(f.min_depth)) return keys;
+  const double s = c.voxel_size_m;
+  const double mu = c.truncation();
+  const double block_m = kTsdfBlockSide * s;
+  const int stride = std::max(
+      1, static_cast<int>(std::floor(0.5 * s * std::min(camera.fx, camera.fy) / f.min_depth)));
+  const int samples = std::max(2, static_cast<int>(std::ceil(2.0 * mu / (0.5 * block_m))) + 1);
+  const Eigen::Matrix3d R = T.linear();
+  const Eigen::Vector3d t = T.translation();
+  const int w = camera.width, h = camera.height;
+  Eigen::Vector3i last(std::numeric_limits<int>::min(), 0, 0);
+  const auto next = [stride](int a, int size) {
+    // Every stride-th pixel and always the last one.
+    return a + stride < size || a == size - 1 ? a + stride : size - 1;
+  };
+  for (int v = 0; v < h; v = next(v, h)) {
+    for (int u = 0; u < w; u = next(u, w)) {
+      const float d = f.depth[static_cast<std::size_t>(v) * w + u];
+      if (!std::isfinite(d)) continue;
+      const Eigen::Vector3d ray((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+      const double norm = ray.norm();
+      const double range = d * norm;
+      const Eigen::Vector3d dir = R * (ray / norm);
+      const double r0 = std::max(0.0, range - mu);
+      const double step = (range + mu - r0) / (samples - 1);
+      for (int k = 0; k < samples; ++k) {
+        const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), 1.0 / s);
+        if (key == last) continue;
+        last = key;
+        keys.insert(key);
+      }
+    }
+  }
+  return keys;
 }
 
 void evict(TsdfMap* map, const Eigen::Vector3d& origin, TsdfIntegrationStats* stats) {
@@ -74,48 +165,15 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   TsdfIntegrationStats stats;
   const TsdfConfig& c = map->config();
   const double s = c.voxel_size_m;
-  const double inv_s = 1.0 / s;
   const double mu = c.truncation();
-  const double block_m = kTsdfBlockSide * s;
   const int w = camera.width;
   const int h = camera.height;
   const std::uint64_t generation = map->beginIntegration();
+  const DepthFrame frame = prepare(depth, camera, c, &stats);
+  const auto keys = bandBlocks(frame, camera, T_map_camera, c);
 
-  // 1. Blocks the truncation band of every valid pixel passes through. Neighbouring pixels
-  //    mostly land in the same block, so a one-entry cache skips most hash lookups.
-  tsl::robin_set<Eigen::Vector3i, BlockIndexHash> keys;
-  const Eigen::Matrix3d R = T_map_camera.linear();
-  const Eigen::Vector3d t = T_map_camera.translation();
-  const int samples = std::max(2, static_cast<int>(std::ceil(2.0 * mu / (0.5 * block_m))) + 1);
-  Eigen::Vector3i last(std::numeric_limits<int>::min(), 0, 0);
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const float d = depth[static_cast<std::size_t>(v) * w + u];
-      if (std::isinf(d) && d > 0.0f) {
-        ++stats.pixels_no_return;
-        continue;
-      }
-      if (!(d >= c.min_depth_m && d <= c.max_depth_m)) {
-        ++stats.pixels_invalid;
-        continue;
-      }
-      ++stats.pixels_valid;
-      const Eigen::Vector3d ray((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
-      const double range = d * ray.norm();
-      const Eigen::Vector3d dir = R * (ray / ray.norm());
-      const double r0 = std::max(0.0, range - mu);
-      const double step = (range + mu - r0) / (samples - 1);
-      for (int k = 0; k < samples; ++k) {
-        const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), inv_s);
-        if (key == last) continue;
-        last = key;
-        keys.insert(key);
-      }
-    }
-  }
-
-  // 2. Every voxel of those blocks: project to the nearest pixel centre, fuse.
-  const float max_step = static_cast<float>(c.voxel_size_m);
+  // Every voxel of those blocks: project to the nearest pixel centre, fuse.
+  const float max_step = static_cast<float>(s);
   const Eigen::Isometry3d T_camera_map = T_map_camera.inverse();
   const Eigen::Matrix3d Rc = T_camera_map.linear();
   const Eigen::Vector3d dx = Rc.col(0) * s, dy = Rc.col(1) * s, dz = Rc.col(2) * s;
@@ -137,25 +195,37 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
         for (int x = 0; x < kTsdfBlockSide; ++x, p += dx, ++voxel) {
           const double zc = p.z();
           if (zc < c.min_depth_m) continue;
-          const double uf = camera.fx * p.x() / zc + camera.cx;
-          const double vf = camera.fy * p.y() / zc + camera.cy;
-          const long ui = std::lround(uf);
-          const long vi = std::lround(vf);
-          if (ui < 0 || vi < 0 || ui >= w || vi >= h) continue;
-          float d = depth[static_cast<std::size_t>(vi) * w + ui];
-          if (c.interpolate_depth) d = interpolatedDepth(depth, w, h, uf, vf, d, max_step);
+          const double inv_z = 1.0 / zc;
+          const double uf = camera.fx * p.x() * inv_z + camera.cx;
+          const double vf = camera.fy * p.y() * inv_z + camera.cy;
+          // Nearest pixel centre (rounding: no half-pixel bias).
+          if (!(uf >= -0.5 && vf >= -0.5 && uf < w - 0.5 && vf < h - 0.5)) continue;
+          const std::size_t pixel =
+              static_cast<std::size_t>(vf + 0.5) * w + static_cast<std::size_t>(uf + 0.5);
+          const float nearest = frame.depth[pixel];
           double sdf;
-          if (std::isinf(d) && d > 0.0f) {
+          if (std::isinf(nearest)) {
             if (zc > c.max_depth_m) continue;
             sdf = mu;  // no return within range: free along the whole ray
-          } else if (d >= c.min_depth_m && d <= c.max_depth_m) {
-            sdf = (d - zc) * (p.norm() / zc);
-            if (sdf < -mu) continue;
+          } else if (nearest == nearest) {
+            // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table. Interpolation
+            // moves the depth by at most max_step, so voxels clearly outside the band skip it.
+            const double along_axis = nearest - zc;
+            if (along_axis < -mu - max_step) continue;
+            if (along_axis > mu + max_step) {
+              sdf = mu;
+            } else {
+              const float d = c.interpolate_depth
+                                  ? interpolatedDepth(frame, w, h, uf, vf, nearest, max_step)
+                                  : nearest;
+              sdf = (d - zc) * frame.range_per_depth[pixel];
+              if (sdf < -mu) continue;
+            }
           } else {
-            continue;
+            continue;  // NaN: invalid pixel
           }
           const float dn = static_cast<float>(std::min(1.0, sdf / mu));
-          map->fuse(voxel, dn, observationWeight(c, std::isinf(d) ? zc : d, sdf, mu));
+          map->fuse(voxel, dn, observationWeight(c, std::isinf(nearest) ? zc : nearest, sdf, mu));
           ++stats.voxels_updated;
           touched = true;
         }
@@ -163,8 +233,15 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
     }
     if (touched) block->updated_stamp = generation;
   }
-  evict(map, t, &stats);
+  evict(map, T_map_camera.translation(), &stats);
   return stats;
+}
+
+void millimetresToMetres(const std::uint16_t* millimetres, std::size_t count, float* metres) {
+  for (std::size_t i = 0; i < count; ++i) {
+    metres[i] = millimetres[i] == 0 ? std::numeric_limits<float>::quiet_NaN()
+                                    : 0.001f * static_cast<float>(millimetres[i]);
+  }
 }
 
 TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vector3d>& points,

@@ -1,4 +1,5 @@
-"""Pure-numpy simulation: analytic worlds, a 2-D lidar and robot trajectories."""
+"""Pure-numpy simulation: analytic worlds, a 2-D lidar, robot trajectories, moving objects with a
+detector, and 3-D scenes with a depth camera (sim.depth_camera)."""
 
 from downstream_perception.sim.lidar import Lidar, LidarConfig
 from downstream_perception.sim.objects import Frame, ObjectScene, SceneConfig

@@ -4,6 +4,8 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include "downstream_perception/core/tsdf/tsdf_map.h"
@@ -41,6 +43,9 @@ struct TsdfIntegrationStats {
 /// sdf = (depth - z) * |(x/z, y/z, 1)|: the range difference along the ray through the voxel.
 TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const PinholeCamera& camera,
                                     const Eigen::Isometry3d& T_map_camera);
+
+/// 16UC1 depth (mm, 0 = invalid: REP-118) to metres (NaN where invalid), for integrateDepth.
+void millimetresToMetres(const std::uint16_t* millimetres, std::size_t count, float* metres);
 
 /// Integrates points (map frame) seen from `origin` (map frame): each voxel the ray crosses
 /// within mu of its end point is updated with the signed distance along the ray.

@@ -1,0 +1,191 @@
+// Python bindings of the TSDF core: depth images and points in, field samples and meshes out.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+
+/// The map and its incremental mesher, as one Python object.
+struct Tsdf {
+  explicit Tsdf(const TsdfConfig& config) : map(config) {}
+  TsdfMap map;
+  TsdfMesher mesher;
+};
+
+Eigen::Isometry3d toIsometry(const Eigen::Matrix4d& m) {
+  if (!m.allFinite() || (m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9) {
+    throw std::invalid_argument("T_map_camera must be a finite 4 x 4 homogeneous transform");
+  }
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  if ((r * r.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
+    throw std::invalid_argument("T_map_camera's rotation is not orthonormal");
+  }
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = r;
+  t.translation() = m.topRightCorner<3, 1>();
+  return t;
+}
+
+py::dict meshToDict(const TriangleMesh& mesh) {
+  const auto nv = static_cast<py::ssize_t>(mesh.vertices.size());
+  const auto nt = static_cast<py::ssize_t>(mesh.triangleCount());
+  py::array_t<float> vertices({nv, py::ssize_t{3}}), normals({nv, py::ssize_t{3}});
+  py::array_t<std::uint32_t> triangles({nt, py::ssize_t{3}});
+  auto v = vertices.mutable_unchecked<2>();
+  auto n = normals.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < nv; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      v(i, k) = mesh.vertices[i](k);
+      n(i, k) = mesh.normals[i](k);
+    }
+  }
+  std::copy(mesh.triangles.begin(), mesh.triangles.end(), triangles.mutable_data());
+  py::dict out;
+  out["vertices"] = vertices;
+  out["normals"] = normals;
+  out["triangles"] = triangles;
+  return out;
+}
+
+}  // namespace
+
+void bindTsdf(py::module& m) {
+  py::enum_<TsdfConfig::Weighting>(m, "TsdfWeighting")
+      .value("CONSTANT", TsdfConfig::Weighting::kConstant)
+      .value("INVERSE_SQUARE_DEPTH", TsdfConfig::Weighting::kInverseSquareDepth);
+  py::class_<TsdfConfig>(m, "TsdfConfig")
+      .def(py::init<>())
+      .def_readwrite("voxel_size_m", &TsdfConfig::voxel_size_m)
+      .def_readwrite("truncation_voxels", &TsdfConfig::truncation_voxels)
+      .def_readwrite("max_weight", &TsdfConfig::max_weight)
+      .def_readwrite("weighting", &TsdfConfig::weighting)
+      .def_readwrite("behind_surface_dropoff", &TsdfConfig::behind_surface_dropoff)
+      .def_readwrite("interpolate_depth", &TsdfConfig::interpolate_depth)
+      .def_readwrite("min_depth_m", &TsdfConfig::min_depth_m)
+      .def_readwrite("max_depth_m", &TsdfConfig::max_depth_m)
+      .def_readwrite("min_weight", &TsdfConfig::min_weight)
+      .def_readwrite("max_blocks", &TsdfConfig::max_blocks)
+      .def_readwrite("max_block_distance_m", &TsdfConfig::max_block_distance_m)
+      .def("truncation", &TsdfConfig::truncation, "mu in metres")
+      .def("validate", &TsdfConfig::validate);
+  py::class_<PinholeCamera>(m, "PinholeCamera",
+                            "Pinhole intrinsics (pixels), ROS optical convention.")
+      .def(py::init([](double fx, double fy, double cx, double cy, int width, int height) {
+             PinholeCamera c{fx, fy, cx, cy, width, height};
+             const std::string why = c.validate();
+             if (!why.empty()) throw std::invalid_argument("camera: " + why);
+             return c;
+           }),
+           py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"),
+           py::arg("height"))
+      .def_readonly("fx", &PinholeCamera::fx)
+      .def_readonly("fy", &PinholeCamera::fy)
+      .def_readonly("cx", &PinholeCamera::cx)
+      .def_readonly("cy", &PinholeCamera::cy)
+      .def_readonly("width", &PinholeCamera::width)
+      .def_readonly("height", &PinholeCamera::height);
+  py::class_<TsdfIntegrationStats>(m, "TsdfIntegrationStats")
+      .def_readonly("pixels_valid", &TsdfIntegrationStats::pixels_valid)
+      .def_readonly("pixels_invalid", &TsdfIntegrationStats::pixels_invalid)
+      .def_readonly("pixels_no_return", &TsdfIntegrationStats::pixels_no_return)
+      .def_readonly("blocks_touched", &TsdfIntegrationStats::blocks_touched)
+      .def_readonly("blocks_allocated", &TsdfIntegrationStats::blocks_allocated)
+      .def_readonly("blocks_refused", &TsdfIntegrationStats::blocks_refused)
+      .def_readonly("blocks_evicted", &TsdfIntegrationStats::blocks_evicted)
+      .def_readonly("voxels_updated", &TsdfIntegrationStats::voxels_updated);
+
+  py::class_<Tsdf>(m, "Tsdf",
+                   "Sparse TSDF (8^3-voxel blocks) with an incremental marching-cubes mesher.")
+      .def(py::init([](const TsdfConfig& c) { return std::make_unique<Tsdf>(c); }),
+           py::arg("config") = TsdfConfig{})
+      .def_property_readonly("config", [](const Tsdf& t) { return t.map.config(); })
+      .def(
+          "integrate_depth",
+          [](Tsdf& self, const py::array& depth, const PinholeCamera& camera,
+             const Eigen::Matrix4d& T_map_camera) {
+            if (depth.ndim() != 2 || depth.shape(0) != camera.height ||
+                depth.shape(1) != camera.width) {
+              throw std::invalid_argument("depth must be (height, width) = (" +
+                                          std::to_string(camera.height) + ", " +
+                                          std::to_string(camera.width) + ")");
+            }
+            const Eigen::Isometry3d pose = toIsometry(T_map_camera);
+            std::vector<float> metres(static_cast<std::size_t>(depth.size()));
+            if (py::isinstance<py::array_t<std::uint16_t>>(depth)) {
+              const auto mm = py::array_t<std::uint16_t, py::array::c_style>::ensure(depth);
+              millimetresToMetres(mm.data(), metres.size(), metres.data());
+            } else if (py::isinstance<py::array_t<float>>(depth) ||
+                       py::isinstance<py::array_t<double>>(depth)) {
+              const auto m =
+                  py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(depth);
+              std::copy(m.data(), m.data() + metres.size(), metres.begin());
+            } else {
+              throw std::invalid_argument("depth must be float (m) or uint16 (mm)");
+            }
+            py::gil_scoped_release release;
+            return integrateDepth(&self.map, metres.data(), camera, pose);
+          },
+          py::arg("depth"), py::arg("camera"), py::arg("T_map_camera"),
+          "Fuses a depth image: float32 metres (NaN/0 invalid, +Inf no return) or uint16 "
+          "millimetres (0 invalid), T_map_camera a 4 x 4 pose of the optical frame.")
+      .def(
+          "integrate_points",
+          [](Tsdf& self, const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& points,
+             const Eigen::Vector3d& origin) {
+            std::vector<Eigen::Vector3d> p(points.rows());
+            for (Eigen::Index i = 0; i < points.rows(); ++i) p[i] = points.row(i).transpose();
+            py::gil_scoped_release release;
+            return integratePoints(&self.map, p, origin);
+          },
+          py::arg("points"), py::arg("origin"),
+          "Fuses points (N, 3) in the map frame seen from origin (3,).")
+      .def(
+          "sample",
+          [](const Tsdf& self,
+             const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& points) {
+            const auto n = static_cast<py::ssize_t>(points.rows());
+            py::array_t<double> distance(n), weight(n);
+            const double mu = self.map.config().truncation();
+            for (py::ssize_t i = 0; i < n; ++i) {
+              const TsdfVoxel* v = self.map.voxel(self.map.voxelAt(points.row(i).transpose()));
+              const bool known = v != nullptr && v->weight > self.map.config().min_weight;
+              distance.mutable_at(i) = known ? v->distance * mu : std::nan("");
+              weight.mutable_at(i) = v == nullptr ? 0.0 : v->weight;
+            }
+            return py::make_tuple(distance, weight);
+          },
+          py::arg("points"),
+          "Signed distance (m, NaN where unobserved) and weight of the voxel nearest each point.")
+      .def(
+          "update_mesh", [](Tsdf& self) { return self.mesher.update(self.map); },
+          "Re-extracts the blocks changed since the last call; returns how many.")
+      .def(
+          "mesh", [](const Tsdf& self) { return meshToDict(self.mesher.combined()); },
+          "The mesh as of the last update_mesh(): dict of vertices (V, 3) float32 m, normals "
+          "(V, 3), triangles (T, 3) uint32.")
+      .def(
+          "write_ply",
+          [](const Tsdf& self, const std::string& path) {
+            const std::string why = self.mesher.combined().writePly(path);
+            if (!why.empty()) throw std::runtime_error(why);
+          },
+          py::arg("path"))
+      .def_property_readonly("block_count", [](const Tsdf& t) { return t.map.blockCount(); })
+      .def_property_readonly("memory_bytes", [](const Tsdf& t) { return t.map.memoryBytes(); })
+      .def("clear", [](Tsdf& self) {
+        self.map.clear();
+        self.mesher.clear();
+      });
+}
