@@ -15,6 +15,7 @@ import subprocess
 import time
 from pathlib import Path
 
+import bench_tsdf  # scripts/bench_tsdf.py, next to this file
 import numpy as np
 
 # costmap_2d ObstacleLayer (binary, Bresenham) "obstacle total" per update, 360 beams, 30 m rays,
@@ -140,6 +141,7 @@ def main() -> None:
     plotted = plot_sweep(sweep, out / "bench_inflation.png")
     binding = python_binding_overhead()
     sim = simulator_speed()
+    tsdf = bench_tsdf.run()
 
     lines = [
         "# downstream_perception benchmark",
@@ -252,6 +254,7 @@ def main() -> None:
             for r in tracker
         ),
         "",
+        *bench_tsdf.markdown(tsdf),
         "## Python side",
         "",
         f"- one 360-beam scan through the pybind11 binding (200^2): median "
@@ -272,6 +275,7 @@ def main() -> None:
                 "cloud": cloud,
                 "decay": decay,
                 "tracker": tracker,
+                "tsdf": tsdf,
                 "binding": binding,
                 "sim": sim,
             },
