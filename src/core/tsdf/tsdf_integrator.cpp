@@ -26,11 +26,11 @@ namespace {
 
 /// Observation weight of a depth z (m) for the configured weighting, with the behind-surface
 /// drop-off applied to sdf (m).
-float observationWeight(const TsdfConfig& c, double z, double sdf, double mu) {
-  double w = c.weighting == TsdfConfig::Weighting::kInverseSquareDepth ? 1.0 / (z * z) : 1.0;
-  const double s = c.voxel_size_m;
+float observationWeight(const TsdfConfig& c, float z, float sdf, float mu) {
+  float w = c.weighting == TsdfConfig::Weighting::kInverseSquareDepth ? 1.0f / (z * z) : 1.0f;
+  const float s = static_cast<float>(c.voxel_size_m);
   if (c.behind_surface_dropoff && sdf < -s) w *= (mu + sdf) / (mu - s);
-  return static_cast<float>(w);
+  return w;
 }
 
 Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
@@ -47,7 +47,10 @@ Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
 struct DepthFrame {
   std::vector<float> depth;
   std::vector<float> inverse;
-  std::vector<float> range_per_depth;  ///< |(x/z, y/z, 1)| of each pixel's ray
+  const float* range_per_depth = nullptr;  ///< |(x/z, y/z, 1)| of each pixel's ray
+  /// Pixels within edge_guard_rad of a depth edge (a jump of more than mu between neighbours, or
+  /// an invalid neighbour): what lies behind them is not known to be behind a surface.
+  std::vector<std::uint8_t> near_edge;
   float min_depth = std::numeric_limits<float>::infinity();
 };
 
@@ -57,15 +60,24 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
   const std::size_t n = static_cast<std::size_t>(camera.width) * camera.height;
   f.depth.resize(n);
   f.inverse.resize(n);
-  f.range_per_depth.resize(n);
-  for (int v = 0; v < camera.height; ++v) {
-    const double y = (v - camera.cy) / camera.fy;
-    for (int u = 0; u < camera.width; ++u) {
-      const double x = (u - camera.cx) / camera.fx;
-      f.range_per_depth[static_cast<std::size_t>(v) * camera.width + u] =
-          static_cast<float>(std::sqrt(1.0 + x * x + y * y));
+  // |ray| / z per pixel depends on the intrinsics only: computed once per camera (per thread).
+  thread_local PinholeCamera cached_camera;
+  thread_local std::vector<float> cached_range;
+  if (cached_range.size() != n || cached_camera.fx != camera.fx || cached_camera.fy != camera.fy ||
+      cached_camera.cx != camera.cx || cached_camera.cy != camera.cy ||
+      cached_camera.width != camera.width) {
+    cached_range.resize(n);
+    for (int v = 0; v < camera.height; ++v) {
+      const double y = (v - camera.cy) / camera.fy;
+      for (int u = 0; u < camera.width; ++u) {
+        const double x = (u - camera.cx) / camera.fx;
+        cached_range[static_cast<std::size_t>(v) * camera.width + u] =
+            static_cast<float>(std::sqrt(1.0 + x * x + y * y));
+      }
     }
+    cached_camera = camera;
   }
+  f.range_per_depth = cached_range.data();
   for (std::size_t i = 0; i < n; ++i) {
     const float d = depth[i];
     if (std::isinf(d) && d > 0.0f) {
@@ -83,6 +95,52 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
       f.inverse[i] = 0.0f;
     }
   }
+  const int radius =
+      static_cast<int>(std::ceil(c.edge_guard_rad * std::max(camera.fx, camera.fy) - 1e-9));
+  if (radius > 0) {
+    const int w = camera.width, h = camera.height;
+    std::vector<std::uint8_t> edge(n, 0);
+    const float jump = static_cast<float>(c.truncation());
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        if (f.inverse[i] == 0.0f) continue;
+        const float d = f.depth[i];
+        const auto differs = [&](std::size_t j) {
+          return f.inverse[j] == 0.0f || std::abs(f.depth[j] - d) > jump;
+        };
+        edge[i] = (u + 1 < w && differs(i + 1)) || (u > 0 && differs(i - 1)) ||
+                  (v + 1 < h && differs(i + w)) || (v > 0 && differs(i - w));
+      }
+    }
+    // Dilate by `radius` (separable box: rows, then columns).
+    std::vector<std::uint8_t> rows(n, 0);
+    for (int v = 0; v < h; ++v) {
+      int last = -1000000;
+      for (int u = 0; u < w; ++u) {
+        if (edge[static_cast<std::size_t>(v) * w + u]) last = u;
+        if (u - last <= radius) rows[static_cast<std::size_t>(v) * w + u] = 1;
+      }
+      last = 1000000;
+      for (int u = w - 1; u >= 0; --u) {
+        if (edge[static_cast<std::size_t>(v) * w + u]) last = u;
+        if (last - u <= radius) rows[static_cast<std::size_t>(v) * w + u] = 1;
+      }
+    }
+    f.near_edge.assign(n, 0);
+    for (int u = 0; u < w; ++u) {
+      int last = -1000000;
+      for (int v = 0; v < h; ++v) {
+        if (rows[static_cast<std::size_t>(v) * w + u]) last = v;
+        if (v - last <= radius) f.near_edge[static_cast<std::size_t>(v) * w + u] = 1;
+      }
+      last = 1000000;
+      for (int v = h - 1; v >= 0; --v) {
+        if (rows[static_cast<std::size_t>(v) * w + u]) last = v;
+        if (last - v <= radius) f.near_edge[static_cast<std::size_t>(v) * w + u] = 1;
+      }
+    }
+  }
   return f;
 }
 
@@ -90,9 +148,9 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
 /// surrounding pixel centres (exact on planes, where 1/z is affine in the image), or `nearest`
 /// when a neighbour is not a valid depth or the four differ by more than `max_step` (a depth
 /// edge: interpolating there would put surface in free space).
-float interpolatedDepth(const DepthFrame& f, int w, int h, double uf, double vf, float nearest,
+float interpolatedDepth(const DepthFrame& f, int w, int h, float uf, float vf, float nearest,
                         float max_step) {
-  if (uf < 0.0 || vf < 0.0) return nearest;
+  if (uf < 0.0f || vf < 0.0f) return nearest;
   const int u0 = static_cast<int>(uf);
   const int v0 = static_cast<int>(vf);
   if (u0 + 1 >= w || v0 + 1 >= h) return nearest;
@@ -104,7 +162,7 @@ float interpolatedDepth(const DepthFrame& f, int w, int h, double uf, double vf,
   const float lo = std::min(std::min(d[0], d[1]), std::min(d[w], d[w + 1]));
   const float hi = std::max(std::max(d[0], d[1]), std::max(d[w], d[w + 1]));
   if (hi - lo > max_step) return nearest;
-  const float a = static_cast<float>(uf - u0), b = static_cast<float>(vf - v0);
+  const float a = uf - static_cast<float>(u0), b = vf - static_cast<float>(v0);
   return 1.0f / ((1.0f - b) * ((1.0f - a) * i00 + a * i10) + b * ((1.0f - a) * i01 + a * i11));
 }
 
@@ -175,8 +233,17 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   // Every voxel of those blocks: project to the nearest pixel centre, fuse.
   const float max_step = static_cast<float>(s);
   const Eigen::Isometry3d T_camera_map = T_map_camera.inverse();
-  const Eigen::Matrix3d Rc = T_camera_map.linear();
-  const Eigen::Vector3d dx = Rc.col(0) * s, dy = Rc.col(1) * s, dz = Rc.col(2) * s;
+  // The voxel loop runs in float (voxel positions relative to the camera, within max_depth_m:
+  // float resolves them to well under a micrometre per metre).
+  const Eigen::Matrix3f Rc = T_camera_map.linear().cast<float>();
+  const Eigen::Vector3f dx = Rc.col(0) * static_cast<float>(s);
+  const Eigen::Vector3f dy = Rc.col(1) * static_cast<float>(s);
+  const Eigen::Vector3f dz = Rc.col(2) * static_cast<float>(s);
+  const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const float cx = static_cast<float>(camera.cx) + 0.5f, cy = static_cast<float>(camera.cy) + 0.5f;
+  const float min_z = static_cast<float>(c.min_depth_m), max_z = static_cast<float>(c.max_depth_m);
+  const float muf = static_cast<float>(mu), sf = static_cast<float>(s);
+  const float u_end = static_cast<float>(w), v_end = static_cast<float>(h);
   for (const Eigen::Vector3i& key : keys) {
     const bool existed = map->find(key) != nullptr;
     TsdfBlock* block = map->allocate(key);
@@ -187,45 +254,48 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
     stats.blocks_allocated += !existed;
     ++stats.blocks_touched;
     bool touched = false;
-    const Eigen::Vector3d base = T_camera_map * ((key * kTsdfBlockSide).cast<double>() * s);
+    const Eigen::Vector3f base =
+        (T_camera_map * ((key * kTsdfBlockSide).cast<double>() * s)).cast<float>();
     for (int z = 0; z < kTsdfBlockSide; ++z) {
       for (int y = 0; y < kTsdfBlockSide; ++y) {
-        Eigen::Vector3d p = base + dz * z + dy * y;
+        Eigen::Vector3f p = base + dz * static_cast<float>(z) + dy * static_cast<float>(y);
         TsdfVoxel* voxel = &block->voxels[TsdfBlock::linear(0, y, z)];
         for (int x = 0; x < kTsdfBlockSide; ++x, p += dx, ++voxel) {
-          const double zc = p.z();
-          if (zc < c.min_depth_m) continue;
-          const double inv_z = 1.0 / zc;
-          const double uf = camera.fx * p.x() * inv_z + camera.cx;
-          const double vf = camera.fy * p.y() * inv_z + camera.cy;
-          // Nearest pixel centre (rounding: no half-pixel bias).
-          if (!(uf >= -0.5 && vf >= -0.5 && uf < w - 0.5 && vf < h - 0.5)) continue;
-          const std::size_t pixel =
-              static_cast<std::size_t>(vf + 0.5) * w + static_cast<std::size_t>(uf + 0.5);
+          const float zc = p.z();
+          if (zc < min_z) continue;
+          const float inv_z = 1.0f / zc;
+          // Shifted by half a pixel, so truncation below is rounding to the nearest pixel
+          // centre (no half-pixel bias).
+          const float us = fx * p.x() * inv_z + cx;
+          const float vs = fy * p.y() * inv_z + cy;
+          if (!(us >= 0.0f && vs >= 0.0f && us < u_end && vs < v_end)) continue;
+          const std::size_t pixel = static_cast<std::size_t>(vs) * w + static_cast<std::size_t>(us);
           const float nearest = frame.depth[pixel];
-          double sdf;
-          if (std::isinf(nearest)) {
-            if (zc > c.max_depth_m) continue;
-            sdf = mu;  // no return within range: free along the whole ray
+          float sdf;
+          if (nearest > max_z) {  // +Inf: no return within range, free along the whole ray
+            if (zc > max_z) continue;
+            sdf = muf;
           } else if (nearest == nearest) {
             // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table. Interpolation
             // moves the depth by at most max_step, so voxels clearly outside the band skip it.
-            const double along_axis = nearest - zc;
-            if (along_axis < -mu - max_step) continue;
-            if (along_axis > mu + max_step) {
-              sdf = mu;
+            const float along_axis = nearest - zc;
+            if (along_axis < -muf - max_step) continue;
+            if (along_axis > muf + max_step) {
+              sdf = muf;
             } else {
-              const float d = c.interpolate_depth
-                                  ? interpolatedDepth(frame, w, h, uf, vf, nearest, max_step)
-                                  : nearest;
+              const float d = c.interpolate_depth ? interpolatedDepth(frame, w, h, us - 0.5f,
+                                                                      vs - 0.5f, nearest, max_step)
+                                                  : nearest;
               sdf = (d - zc) * frame.range_per_depth[pixel];
-              if (sdf < -mu) continue;
+              if (sdf < -muf) continue;
+              // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
+              if (sdf < -sf && !frame.near_edge.empty() && frame.near_edge[pixel]) continue;
             }
           } else {
             continue;  // NaN: invalid pixel
           }
-          const float dn = static_cast<float>(std::min(1.0, sdf / mu));
-          map->fuse(voxel, dn, observationWeight(c, std::isinf(nearest) ? zc : nearest, sdf, mu));
+          const float dn = std::min(1.0f, sdf / muf);
+          map->fuse(voxel, dn, observationWeight(c, nearest > max_z ? zc : nearest, sdf, muf));
           ++stats.voxels_updated;
           touched = true;
         }

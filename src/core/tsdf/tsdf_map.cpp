@@ -19,6 +19,8 @@ std::string TsdfConfig::validate() const {
     why << "need 0 < min_depth_m < max_depth_m, got " << min_depth_m << " and " << max_depth_m;
   } else if (!(std::isfinite(min_weight) && min_weight >= 0.0)) {
     why << "min_weight must be finite and >= 0, got " << min_weight;
+  } else if (!(std::isfinite(edge_guard_rad) && edge_guard_rad >= 0.0 && edge_guard_rad < 0.2)) {
+    why << "edge_guard_rad must be in [0, 0.2) rad, got " << edge_guard_rad;
   } else if (max_blocks < 1) {
     why << "max_blocks must be >= 1";
   } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {

@@ -35,6 +35,11 @@ struct TsdfConfig {
   /// surface seen from one side does not write a deep negative shell that ghosts when seen from
   /// the other side (voxblox's weight drop-off).
   bool behind_surface_dropoff = true;
+  /// Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle
+  /// (rad) of a depth edge (a jump of more than mu) are not updated. Rays grazing an object's rim
+  /// would otherwise write "inside" values into the free space beyond its edges (the projective
+  /// TSDF's ghost surfaces). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.
+  double edge_guard_rad = 0.0075;
   /// Depth images: read each voxel's depth by interpolating inverse depth between the four
   /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
   /// nearest pixel across depth edges (neighbours differing by more than one voxel).
