@@ -100,16 +100,30 @@ class Scene3D:
         return np.vstack(pts)
 
 
-def room_scene() -> Scene3D:
+def room_scene(offset: tuple[float, float, float] = (0.0073, -0.0041, 0.0029)) -> Scene3D:
     """The anchors' test room: 4 x 4 x 3 m with a box, a floating sphere and a thin pole, plus a
-    table top (a thin slab at 0.75 m) for the costmap slice."""
+    table top (a thin slab at 0.75 m) for the costmap slice.
+
+    Everything is shifted by `offset` (m) so that no surface lies on a plane of voxel centres:
+    such a surface puts D = 0 exactly at voxel centres, a best case for accuracy (vertices land
+    on the lattice) and a bad case for marching cubes' completeness, and real surfaces are not
+    aligned with the map's lattice. offset = (0, 0, 0) gives the aligned room.
+    """
+    o = np.asarray(offset, dtype=float)
+
+    def at(*p: float) -> tuple[float, float, float]:
+        q = np.asarray(p) + o
+        return (float(q[0]), float(q[1]), float(q[2]))
+
     return Scene3D(
+        room_min=at(-2.0, -2.0, 0.0),
+        room_max=at(2.0, 2.0, 3.0),
         boxes=[
-            Box((0.8, 0.6, 0.35), (0.3, 0.25, 0.35)),
-            Box((-0.8, 0.7, 0.74), (0.4, 0.3, 0.02)),  # table top
+            Box(at(0.8, 0.6, 0.35), (0.3, 0.25, 0.35)),
+            Box(at(-0.8, 0.7, 0.74), (0.4, 0.3, 0.02)),  # table top
         ],
-        spheres=[Sphere((-0.5, -0.6, 1.2), 0.3)],
-        cylinders=[Cylinder((0.4, -0.9), 0.03, 0.0, 2.0)],
+        spheres=[Sphere(at(-0.5, -0.6, 1.2), 0.3)],
+        cylinders=[Cylinder(at(0.4, -0.9, 0.0)[:2], 0.03, o[2], 2.0 + o[2])],
     )
 
 

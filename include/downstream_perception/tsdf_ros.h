@@ -1,0 +1,94 @@
+// ROS host of the TSDF: depth images (+ CameraInfo) and/or point clouds in, each fused at its own
+// stamp in a fixed world frame (a tf2 MessageFilter holds a message until its transform exists);
+// the mesh out as per-block rviz markers at ~mesh_rate_hz; services to save the mesh and clear
+// the map; diagnostics. The nodelet and the node are thin shells around it.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <message_filters/subscriber.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <Eigen/Geometry>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/SaveMap.h"
+#include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/running_stats.h"
+#include "downstream_perception/tsdf_mesh_markers.h"
+
+namespace downstream_perception {
+
+/// A depth image as metres (32FC1 as is, 16UC1 millimetres converted, 0 -> NaN). False with a
+/// reason for other encodings, a byte order other than the host's, or an inconsistent size.
+bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
+                        std::string* why);
+
+class TsdfRos {
+ public:
+  TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~TsdfRos();
+
+ private:
+  void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg);
+  void onDepth(const sensor_msgs::ImageConstPtr& msg);
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
+  void onTfFailure(const std::string& what, const std_msgs::Header& header,
+                   tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
+  void publishMesh(const ros::TimerEvent& event);
+  bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);
+  bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void reject(const std::string& reason, const std::string& detail);
+  void account(const TsdfIntegrationStats& stats, double elapsed_ms);
+
+  ros::NodeHandle nh_;
+  ros::NodeHandle pnh_;
+  std::string world_frame_;
+  std::mutex mutex_;  ///< guards the map, the mesher and the counters
+  std::unique_ptr<TsdfMap> map_;
+  TsdfMesher mesher_;
+  TsdfMeshMarkers markers_;
+  std::map<std::string, sensor_msgs::CameraInfo> camera_infos_;  ///< latest per frame id
+
+  std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Subscriber camera_info_subscriber_;
+  std::unique_ptr<message_filters::Subscriber<sensor_msgs::Image>> depth_subscriber_;
+  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::Image>> depth_filter_;
+  std::unique_ptr<message_filters::Subscriber<sensor_msgs::PointCloud2>> cloud_subscriber_;
+  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> cloud_filter_;
+  ros::Publisher mesh_publisher_;
+  ros::ServiceServer save_service_;
+  ros::ServiceServer clear_service_;
+  ros::Timer mesh_timer_;
+  diagnostic_updater::Updater diagnostics_;
+
+  // Diagnostics.
+  std::size_t frames_integrated_ = 0;
+  std::map<std::string, std::size_t> rejected_;
+  TsdfIntegrationStats last_;
+  std::size_t pixels_invalid_ = 0;
+  std::size_t blocks_refused_ = 0;
+  std::size_t blocks_evicted_ = 0;
+  RunningStats integrate_ms_;
+  RunningStats mesh_ms_;
+  std::size_t mesh_triangles_ = 0;
+  std::vector<std::string> config_errors_;
+};
+
+}  // namespace downstream_perception

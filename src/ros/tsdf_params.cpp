@@ -1,0 +1,39 @@
+#include "downstream_perception/tsdf_params.h"
+
+namespace downstream_perception {
+
+TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, std::vector<std::string>* errors) {
+  TsdfConfig c;
+  pnh.param("voxel_size_m", c.voxel_size_m, c.voxel_size_m);
+  pnh.param("truncation_voxels", c.truncation_voxels, c.truncation_voxels);
+  pnh.param("max_weight", c.max_weight, c.max_weight);
+  pnh.param("behind_surface_dropoff", c.behind_surface_dropoff, c.behind_surface_dropoff);
+  pnh.param("interpolate_depth", c.interpolate_depth, c.interpolate_depth);
+  pnh.param("edge_guard_rad", c.edge_guard_rad, c.edge_guard_rad);
+  pnh.param("min_depth_m", c.min_depth_m, c.min_depth_m);
+  pnh.param("max_depth_m", c.max_depth_m, c.max_depth_m);
+  pnh.param("min_weight", c.min_weight, c.min_weight);
+  pnh.param("max_block_distance_m", c.max_block_distance_m, c.max_block_distance_m);
+  int max_blocks = static_cast<int>(c.max_blocks);
+  pnh.param("max_blocks", max_blocks, max_blocks);
+  std::string weighting = "constant";
+  pnh.param("weighting", weighting, weighting);
+
+  std::string why;
+  if (max_blocks < 1) {
+    why = "max_blocks must be >= 1, got " + std::to_string(max_blocks);
+  } else if (weighting != "constant" && weighting != "inverse_square_depth") {
+    why = "weighting must be 'constant' or 'inverse_square_depth', got '" + weighting + "'";
+  } else {
+    c.max_blocks = static_cast<std::size_t>(max_blocks);
+    c.weighting = weighting == "constant" ? TsdfConfig::Weighting::kConstant
+                                          : TsdfConfig::Weighting::kInverseSquareDepth;
+    why = c.validate();
+  }
+  if (why.empty()) return c;
+  errors->push_back("invalid TSDF parameters (" + why + "); using the defaults");
+  ROS_ERROR("tsdf: %s", errors->back().c_str());
+  return TsdfConfig{};
+}
+
+}  // namespace downstream_perception

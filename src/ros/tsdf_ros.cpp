@@ -1,0 +1,368 @@
+#include "downstream_perception/tsdf_ros.h"
+
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "downstream_perception/config_errors.h"
+#include "downstream_perception/tsdf_params.h"
+
+namespace downstream_perception {
+
+namespace {
+
+bool hostIsBigEndian() {
+  const std::uint16_t one = 1;
+  std::uint8_t first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
+}
+
+Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  return T;
+}
+
+}  // namespace
+
+bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
+                        std::string* why) {
+  namespace enc = sensor_msgs::image_encodings;
+  const bool is_float = image.encoding == enc::TYPE_32FC1;
+  const bool is_mm = image.encoding == enc::TYPE_16UC1 || image.encoding == enc::MONO16;
+  if (!is_float && !is_mm) {
+    *why = "encoding '" + image.encoding + "' (need 32FC1 metres or 16UC1 millimetres)";
+    return false;
+  }
+  if (static_cast<bool>(image.is_bigendian) != hostIsBigEndian()) {
+    *why = "byte order differs from this machine's";
+    return false;
+  }
+  const std::size_t pixel_bytes = is_float ? 4 : 2;
+  if (image.width == 0 || image.height == 0 || image.step < image.width * pixel_bytes ||
+      image.data.size() < static_cast<std::size_t>(image.step) * image.height) {
+    *why = "size inconsistent (width " + std::to_string(image.width) + ", height " +
+           std::to_string(image.height) + ", step " + std::to_string(image.step) + ", " +
+           std::to_string(image.data.size()) + " bytes)";
+    return false;
+  }
+  metres->resize(static_cast<std::size_t>(image.width) * image.height);
+  for (std::uint32_t v = 0; v < image.height; ++v) {
+    const std::uint8_t* row = image.data.data() + static_cast<std::size_t>(v) * image.step;
+    float* out = metres->data() + static_cast<std::size_t>(v) * image.width;
+    if (is_float) {
+      std::memcpy(out, row, image.width * sizeof(float));
+    } else {
+      std::vector<std::uint16_t> mm(image.width);
+      std::memcpy(mm.data(), row, image.width * sizeof(std::uint16_t));
+      millimetresToMetres(mm.data(), mm.size(), out);
+    }
+  }
+  return true;
+}
+
+TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
+  pnh_.param("world_frame", world_frame_, std::string("odom"));
+  double mesh_rate_hz = 1.0;
+  pnh_.param("mesh_rate_hz", mesh_rate_hz, mesh_rate_hz);
+  if (!(std::isfinite(mesh_rate_hz) && mesh_rate_hz > 0.0 && mesh_rate_hz <= 100.0)) {
+    config_errors_.push_back("parameter ~mesh_rate_hz = " + toText(mesh_rate_hz) +
+                             " must be in (0, 100] Hz; using 1");
+    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    mesh_rate_hz = 1.0;
+  }
+  int tf_queue_size = 10;
+  pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
+  if (tf_queue_size < 1 || tf_queue_size > 1000) {
+    config_errors_.push_back("parameter ~tf_queue_size must be in [1, 1000]; using 10");
+    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    tf_queue_size = 10;
+  }
+  map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
+
+  mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
+  save_service_ = pnh_.advertiseService("save_mesh", &TsdfRos::saveMesh, this);
+  clear_service_ = pnh_.advertiseService("clear", &TsdfRos::clear, this);
+  diagnostics_.setHardwareID("tsdf " + world_frame_);
+  diagnostics_.add("tsdf", this, &TsdfRos::diagnose);
+
+  tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
+  const auto queue = static_cast<std::uint32_t>(tf_queue_size);
+  camera_info_subscriber_ = nh_.subscribe("depth/camera_info", 5, &TsdfRos::onCameraInfo, this);
+  depth_subscriber_ =
+      std::make_unique<message_filters::Subscriber<sensor_msgs::Image>>(nh_, "depth/image", 5);
+  depth_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::Image>>(
+      *depth_subscriber_, *tf_buffer_, world_frame_, queue, nh_);
+  depth_filter_->registerCallback(boost::bind(&TsdfRos::onDepth, this, boost::placeholders::_1));
+  depth_filter_->registerFailureCallback(
+      [this](const sensor_msgs::ImageConstPtr& m,
+             tf2_ros::filter_failure_reasons::FilterFailureReason r) {
+        onTfFailure("depth image", m->header, r);
+      });
+  cloud_subscriber_ =
+      std::make_unique<message_filters::Subscriber<sensor_msgs::PointCloud2>>(nh_, "points", 5);
+  cloud_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>>(
+      *cloud_subscriber_, *tf_buffer_, world_frame_, queue, nh_);
+  cloud_filter_->registerCallback(boost::bind(&TsdfRos::onCloud, this, boost::placeholders::_1));
+  cloud_filter_->registerFailureCallback(
+      [this](const sensor_msgs::PointCloud2ConstPtr& m,
+             tf2_ros::filter_failure_reasons::FilterFailureReason r) {
+        onTfFailure("point cloud", m->header, r);
+      });
+  mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
+  const TsdfConfig& c = map_->config();
+  ROS_INFO("tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s",
+           c.voxel_size_m, c.truncation(), world_frame_.c_str(),
+           ros::names::resolve(nh_.getNamespace(), "depth/image").c_str(),
+           ros::names::resolve(nh_.getNamespace(), "points").c_str());
+}
+
+TsdfRos::~TsdfRos() {
+  mesh_timer_.stop();
+  depth_filter_.reset();
+  depth_subscriber_.reset();
+  cloud_filter_.reset();
+  cloud_subscriber_.reset();
+}
+
+void TsdfRos::reject(const std::string& reason, const std::string& detail) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++rejected_[reason];
+  }
+  ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s: %s", reason.c_str(), detail.c_str());
+}
+
+void TsdfRos::onTfFailure(const std::string& what, const std_msgs::Header& header,
+                          tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  std::ostringstream detail;
+  detail << what << " in '" << header.frame_id << "' at stamp " << header.stamp;
+  reject(reason == tf2_ros::filter_failure_reasons::OutTheBack
+             ? "tf: older than the transform cache"
+             : "tf: no transform in time (unknown frame or late tf)",
+         detail.str());
+}
+
+bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::string* why) {
+  try {
+    *T =
+        toEigen(tf_buffer_->lookupTransform(world_frame_, header.frame_id, header.stamp).transform);
+    return true;
+  } catch (const tf2::TransformException& e) {
+    *why = e.what();
+    return false;
+  }
+}
+
+void TsdfRos::onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  camera_infos_[msg->header.frame_id] = *msg;
+}
+
+void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
+  ++frames_integrated_;
+  last_ = stats;
+  pixels_invalid_ += stats.pixels_invalid;
+  blocks_refused_ += stats.blocks_refused;
+  blocks_evicted_ += stats.blocks_evicted;
+  integrate_ms_.add(elapsed_ms);
+}
+
+void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
+  if (msg->header.stamp.isZero()) {
+    reject("bad message: zero stamp", "depth images must carry their measurement time");
+    return;
+  }
+  std::vector<float> metres;
+  std::string why;
+  if (!depthImageToMetres(*msg, &metres, &why)) {
+    reject("bad depth image", why);
+    return;
+  }
+  PinholeCamera camera;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = camera_infos_.find(msg->header.frame_id);
+    if (it == camera_infos_.end()) {
+      why = "no CameraInfo yet for frame '" + msg->header.frame_id + "'";
+    } else if (it->second.width != msg->width || it->second.height != msg->height) {
+      why = "image " + std::to_string(msg->width) + "x" + std::to_string(msg->height) +
+            " but CameraInfo " + std::to_string(it->second.width) + "x" +
+            std::to_string(it->second.height);
+    } else {
+      const auto& K = it->second.K;
+      camera = PinholeCamera{
+          K[0], K[4], K[2], K[5], static_cast<int>(msg->width), static_cast<int>(msg->height)};
+      why = camera.validate();
+    }
+  }
+  if (!why.empty()) {
+    reject("camera_info missing or inconsistent", why);
+    return;
+  }
+  Eigen::Isometry3d T_world_camera;
+  if (!lookup(msg->header, &T_world_camera, &why)) {
+    reject("tf: lookup at stamp failed", why);
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto t0 = std::chrono::steady_clock::now();
+    const TsdfIntegrationStats stats =
+        integrateDepth(map_.get(), metres.data(), camera, T_world_camera);
+    account(
+        stats,
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  diagnostics_.update();
+}
+
+void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  if (msg->header.stamp.isZero()) {
+    reject("bad message: zero stamp", "point clouds must carry their measurement time");
+    return;
+  }
+  bool has_xyz[3] = {false, false, false};
+  for (const auto& f : msg->fields) {
+    for (int k = 0; k < 3; ++k) {
+      if (f.name == std::string(1, static_cast<char>('x' + k)) &&
+          f.datatype == sensor_msgs::PointField::FLOAT32) {
+        has_xyz[k] = true;
+      }
+    }
+  }
+  if (!has_xyz[0] || !has_xyz[1] || !has_xyz[2] ||
+      msg->data.size() < static_cast<std::size_t>(msg->row_step) * msg->height ||
+      msg->row_step < msg->width * msg->point_step) {
+    reject("bad point cloud", "need float32 x, y, z fields and a consistent size");
+    return;
+  }
+  Eigen::Isometry3d T_world_sensor;
+  std::string why;
+  if (!lookup(msg->header, &T_world_sensor, &why)) {
+    reject("tf: lookup at stamp failed", why);
+    return;
+  }
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<std::size_t>(msg->width) * msg->height);
+  for (sensor_msgs::PointCloud2ConstIterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z");
+       x != x.end(); ++x, ++y, ++z) {
+    points.push_back(T_world_sensor * Eigen::Vector3d(*x, *y, *z));  // NaN stays NaN: counted
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto t0 = std::chrono::steady_clock::now();
+    const TsdfIntegrationStats stats =
+        integratePoints(map_.get(), points, T_world_sensor.translation());
+    account(
+        stats,
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  diagnostics_.update();
+}
+
+void TsdfRos::publishMesh(const ros::TimerEvent&) {
+  visualization_msgs::MarkerArray markers;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto t0 = std::chrono::steady_clock::now();
+    mesher_.update(*map_);  // evicted blocks are reported by markers_.changed() too
+    mesh_ms_.add(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    std_msgs::Header header;
+    header.frame_id = world_frame_;
+    header.stamp = ros::Time::now();
+    markers = markers_.changed(mesher_, header);
+    mesh_triangles_ = 0;
+    for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
+  }
+  if (!markers.markers.empty()) mesh_publisher_.publish(markers);
+  diagnostics_.update();
+}
+
+bool TsdfRos::saveMesh(SaveMap::Request& request, SaveMap::Response& response) {
+  TriangleMesh mesh;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    mesher_.update(*map_);
+    mesh = mesher_.combined();
+  }
+  if (request.path.size() < 5 || request.path.substr(request.path.size() - 4) != ".ply") {
+    response.success = false;
+    response.message = "only .ply is supported, got '" + request.path + "'";
+  } else {
+    const std::string why = mesh.writePly(request.path);
+    response.success = why.empty();
+    response.message = why.empty() ? "wrote " + std::to_string(mesh.vertices.size()) +
+                                         " vertices, " + std::to_string(mesh.triangleCount()) +
+                                         " triangles to " + request.path
+                                   : why;
+  }
+  if (response.success) {
+    ROS_INFO("tsdf: %s", response.message.c_str());
+  } else {
+    ROS_ERROR("tsdf: save_mesh failed: %s", response.message.c_str());
+  }
+  return true;
+}
+
+bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  visualization_msgs::MarkerArray markers;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    map_->clear();
+    mesher_.clear();
+    std_msgs::Header header;
+    header.frame_id = world_frame_;
+    header.stamp = ros::Time::now();
+    markers = markers_.clearAll(header);
+  }
+  mesh_publisher_.publish(markers);
+  ROS_INFO("tsdf: map cleared");
+  return true;
+}
+
+void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t rejected = 0;
+  for (const auto& [reason, count] : rejected_) {
+    status.add("rejected (" + reason + ")", count);
+    rejected += count;
+  }
+  status.add("frames integrated", frames_integrated_);
+  status.add("frames rejected", rejected);
+  status.add("integration time mean (ms)", integrate_ms_.mean());
+  status.add("integration time max (ms)", integrate_ms_.max);
+  status.add("last frame: valid pixels or points", last_.pixels_valid);
+  status.add("last frame: voxels updated", last_.voxels_updated);
+  status.add("invalid pixels or points (total)", pixels_invalid_);
+  status.add("blocks", map_->blockCount());
+  status.add("memory (MB)", static_cast<double>(map_->memoryBytes()) / 1e6);
+  status.add("blocks refused at max_blocks (total)", blocks_refused_);
+  status.add("blocks evicted by distance (total)", blocks_evicted_);
+  status.add("mesh triangles", mesh_triangles_);
+  status.add("mesh update time mean (ms)", mesh_ms_.mean());
+  addConfigErrors(status, config_errors_);
+  if (!config_errors_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  } else if (frames_integrated_ == 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame integrated yet");
+  } else if (blocks_refused_ > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "max_blocks reached: parts of the scene are not mapped");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "fusing");
+  }
+}
+
+}  // namespace downstream_perception
