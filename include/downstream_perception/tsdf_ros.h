@@ -5,7 +5,6 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <message_filters/subscriber.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -44,8 +43,12 @@ class TsdfRos {
 
  private:
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg);
-  void onDepth(const sensor_msgs::ImageConstPtr& msg);
+  void onDepthRaw(const sensor_msgs::ImageConstPtr& msg);  ///< checks, then waits for tf
+  void onDepth(const sensor_msgs::ImageConstPtr& msg);     ///< tf available: integrates
+  void onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg);
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
+  /// The pinhole model for an image from the latest CameraInfo of its frame, or why not.
+  bool cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why);
   void onTfFailure(const std::string& what, const std_msgs::Header& header,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
@@ -68,9 +71,9 @@ class TsdfRos {
   std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Subscriber camera_info_subscriber_;
-  std::unique_ptr<message_filters::Subscriber<sensor_msgs::Image>> depth_subscriber_;
+  ros::Subscriber depth_subscriber_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::Image>> depth_filter_;
-  std::unique_ptr<message_filters::Subscriber<sensor_msgs::PointCloud2>> cloud_subscriber_;
+  ros::Subscriber cloud_subscriber_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> cloud_filter_;
   ros::Publisher mesh_publisher_;
   ros::ServiceServer save_service_;

@@ -6,6 +6,7 @@ import math
 import time
 from collections.abc import Callable
 
+import numpy as np
 import rospy
 from geometry_msgs.msg import TransformStamped
 
@@ -29,6 +30,38 @@ def transform_stamped(
     t.transform.translation.z = float(z)
     t.transform.rotation.z = math.sin(yaw / 2.0)
     t.transform.rotation.w = math.cos(yaw / 2.0)
+    return t
+
+
+def transform_from_matrix(
+    parent: str, child: str, stamp: rospy.Time, T: np.ndarray
+) -> TransformStamped:
+    """parent <- child from a 4 x 4 homogeneous matrix (rotation to quaternion, Shepperd)."""
+    R = np.asarray(T, dtype=float)[:3, :3]
+    trace = np.trace(R)
+    if trace > 0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q = (0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s)
+    else:
+        i = int(np.argmax(np.diag(R)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + R[i, i] - R[j, j] - R[k, k])
+        v = [0.0, 0.0, 0.0]
+        v[i] = 0.25 * s
+        v[j] = (R[j, i] + R[i, j]) / s
+        v[k] = (R[k, i] + R[i, k]) / s
+        q = ((R[k, j] - R[j, k]) / s, v[0], v[1], v[2])
+    t = TransformStamped()
+    t.header.frame_id = parent
+    t.header.stamp = stamp
+    t.child_frame_id = child
+    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = (
+        float(T[0, 3]),
+        float(T[1, 3]),
+        float(T[2, 3]),
+    )
+    r = t.transform.rotation
+    r.w, r.x, r.y, r.z = (float(c) for c in q)
     return t
 
 

@@ -99,26 +99,27 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
   const auto queue = static_cast<std::uint32_t>(tf_queue_size);
   camera_info_subscriber_ = nh_.subscribe("depth/camera_info", 5, &TsdfRos::onCameraInfo, this);
-  depth_subscriber_ =
-      std::make_unique<message_filters::Subscriber<sensor_msgs::Image>>(nh_, "depth/image", 5);
+  // Raw subscribers check each message first (a wrong encoding is reported at once instead of
+  // waiting for tf) and pass it to a tf2 MessageFilter, which holds it until the transform to
+  // the world frame at its stamp exists.
   depth_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::Image>>(
-      *depth_subscriber_, *tf_buffer_, world_frame_, queue, nh_);
+      *tf_buffer_, world_frame_, queue, nh_);
   depth_filter_->registerCallback(boost::bind(&TsdfRos::onDepth, this, boost::placeholders::_1));
   depth_filter_->registerFailureCallback(
       [this](const sensor_msgs::ImageConstPtr& m,
              tf2_ros::filter_failure_reasons::FilterFailureReason r) {
         onTfFailure("depth image", m->header, r);
       });
-  cloud_subscriber_ =
-      std::make_unique<message_filters::Subscriber<sensor_msgs::PointCloud2>>(nh_, "points", 5);
+  depth_subscriber_ = nh_.subscribe("depth/image", 5, &TsdfRos::onDepthRaw, this);
   cloud_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>>(
-      *cloud_subscriber_, *tf_buffer_, world_frame_, queue, nh_);
+      *tf_buffer_, world_frame_, queue, nh_);
   cloud_filter_->registerCallback(boost::bind(&TsdfRos::onCloud, this, boost::placeholders::_1));
   cloud_filter_->registerFailureCallback(
       [this](const sensor_msgs::PointCloud2ConstPtr& m,
              tf2_ros::filter_failure_reasons::FilterFailureReason r) {
         onTfFailure("point cloud", m->header, r);
       });
+  cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
   mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
   const TsdfConfig& c = map_->config();
   ROS_INFO("tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s",
@@ -129,10 +130,10 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 TsdfRos::~TsdfRos() {
   mesh_timer_.stop();
+  depth_subscriber_.shutdown();
+  cloud_subscriber_.shutdown();
   depth_filter_.reset();
-  depth_subscriber_.reset();
   cloud_filter_.reset();
-  cloud_subscriber_.reset();
 }
 
 void TsdfRos::reject(const std::string& reason, const std::string& detail) {
@@ -178,39 +179,53 @@ void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
   integrate_ms_.add(elapsed_ms);
 }
 
-void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
+bool TsdfRos::cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = camera_infos_.find(image.header.frame_id);
+  if (it == camera_infos_.end()) {
+    *why = "no CameraInfo yet for frame '" + image.header.frame_id + "'";
+    return false;
+  }
+  if (it->second.width != image.width || it->second.height != image.height) {
+    *why = "image " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+           " but CameraInfo " + std::to_string(it->second.width) + "x" +
+           std::to_string(it->second.height);
+    return false;
+  }
+  const auto& K = it->second.K;
+  *camera = PinholeCamera{
+      K[0], K[4], K[2], K[5], static_cast<int>(image.width), static_cast<int>(image.height)};
+  *why = camera->validate();
+  return why->empty();
+}
+
+void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
     reject("bad message: zero stamp", "depth images must carry their measurement time");
     return;
   }
   std::vector<float> metres;
   std::string why;
+  PinholeCamera camera;
   if (!depthImageToMetres(*msg, &metres, &why)) {
     reject("bad depth image", why);
-    return;
+  } else if (!cameraFor(*msg, &camera, &why)) {
+    reject("camera_info missing or inconsistent", why);
+  } else {
+    depth_filter_->add(msg);
   }
+}
+
+void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
+  std::vector<float> metres;
+  std::string why;
   PinholeCamera camera;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = camera_infos_.find(msg->header.frame_id);
-    if (it == camera_infos_.end()) {
-      why = "no CameraInfo yet for frame '" + msg->header.frame_id + "'";
-    } else if (it->second.width != msg->width || it->second.height != msg->height) {
-      why = "image " + std::to_string(msg->width) + "x" + std::to_string(msg->height) +
-            " but CameraInfo " + std::to_string(it->second.width) + "x" +
-            std::to_string(it->second.height);
-    } else {
-      const auto& K = it->second.K;
-      camera = PinholeCamera{
-          K[0], K[4], K[2], K[5], static_cast<int>(msg->width), static_cast<int>(msg->height)};
-      why = camera.validate();
-    }
-  }
-  if (!why.empty()) {
+  Eigen::Isometry3d T_world_camera;
+  // Checked on arrival already; the CameraInfo may have changed while waiting for tf.
+  if (!depthImageToMetres(*msg, &metres, &why) || !cameraFor(*msg, &camera, &why)) {
     reject("camera_info missing or inconsistent", why);
     return;
   }
-  Eigen::Isometry3d T_world_camera;
   if (!lookup(msg->header, &T_world_camera, &why)) {
     reject("tf: lookup at stamp failed", why);
     return;
@@ -227,7 +242,7 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
   diagnostics_.update();
 }
 
-void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+void TsdfRos::onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
     reject("bad message: zero stamp", "point clouds must carry their measurement time");
     return;
@@ -247,6 +262,10 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     reject("bad point cloud", "need float32 x, y, z fields and a consistent size");
     return;
   }
+  cloud_filter_->add(msg);
+}
+
+void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   Eigen::Isometry3d T_world_sensor;
   std::string why;
   if (!lookup(msg->header, &T_world_sensor, &why)) {

@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""Depth camera simulator node: the analytic room (sim.depth_camera.room_scene) seen from ~frames
+poses on a circle, published at ~rate_hz.
+
+Each frame: tf ~world_frame -> ~camera_frame (optical convention) at the frame's stamp, then
+`depth/camera_info` and `depth/image` (32FC1 metres, NaN = no hit; or 16UC1 millimetres, 0 = no
+hit, with ~encoding: 16UC1). After the last frame, latched std_msgs/Bool(True) on `~done`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import rospy
+import tf2_ros
+from sensor_msgs.msg import CameraInfo, Image
+from std_msgs.msg import Bool, Header
+
+from downstream_perception.ros_util import transform_from_matrix
+from downstream_perception.sim.depth_camera import DepthCamera, circle_poses, room_scene
+
+
+def camera_info(cam: DepthCamera, header: Header) -> CameraInfo:
+    info = CameraInfo()
+    info.header = header
+    info.width, info.height = cam.width, cam.height
+    info.distortion_model = "plumb_bob"
+    info.D = [0.0] * 5
+    info.K = [cam.fx, 0.0, cam.cx, 0.0, cam.fy, cam.cy, 0.0, 0.0, 1.0]
+    info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+    info.P = [cam.fx, 0.0, cam.cx, 0.0, 0.0, cam.fy, cam.cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+    return info
+
+
+def depth_image(depth: np.ndarray, header: Header, encoding: str) -> Image:
+    msg = Image()
+    msg.header = header
+    msg.height, msg.width = depth.shape
+    msg.encoding = encoding
+    msg.is_bigendian = 0
+    if encoding == "16UC1":
+        data = np.nan_to_num(np.rint(depth * 1000.0), nan=0.0).clip(0, 65535).astype("<u2")
+    else:
+        data = depth.astype("<f4")
+    msg.step = msg.width * data.itemsize
+    msg.data = data.tobytes()
+    return msg
+
+
+def main() -> None:
+    rospy.init_node("depth_sim")
+    p = rospy.get_param
+    frames = int(p("~frames", 30))
+    rate_hz = float(p("~rate_hz", 5.0))
+    world = str(p("~world_frame", "odom"))
+    optical = str(p("~camera_frame", "depth_optical"))
+    encoding = str(p("~encoding", "32FC1"))
+    noise = float(p("~depth_noise_m", 0.0))
+    cam = DepthCamera.vga() if p("~resolution", "qvga") == "vga" else DepthCamera()
+    if encoding not in ("32FC1", "16UC1"):
+        rospy.logerr("depth_sim: ~encoding must be 32FC1 or 16UC1; using 32FC1")
+        encoding = "32FC1"
+    scene = room_scene()
+    poses = circle_poses(frames)
+    rng = np.random.default_rng(int(p("~seed", 0)))
+    tf = tf2_ros.TransformBroadcaster()
+    info_pub = rospy.Publisher("depth/camera_info", CameraInfo, queue_size=5)
+    image_pub = rospy.Publisher("depth/image", Image, queue_size=5)
+    done = rospy.Publisher("~done", Bool, queue_size=1, latch=True)
+    rospy.sleep(float(p("~start_delay_s", 2.0)))  # let subscribers connect
+    rate = rospy.Rate(rate_hz)
+    for T in poses:
+        if rospy.is_shutdown():
+            return
+        depth = cam.render(scene, T, depth_noise_m=noise, rng=rng)
+        stamp = rospy.Time.now()
+        tf.sendTransform(transform_from_matrix(world, optical, stamp, T))
+        header = Header(stamp=stamp, frame_id=optical)
+        info_pub.publish(camera_info(cam, header))
+        image_pub.publish(depth_image(depth, header, encoding))
+        rate.sleep()
+    done.publish(Bool(data=True))
+    rospy.spin()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""rostest: the TSDF nodelet on 20 simulated 16UC1 depth frames of the analytic room.
+
+The mesh it publishes (per-block TRIANGLE_LIST markers) must lie on the room's true surfaces;
+~save_mesh writes a PLY with as many vertices as it reports; frames with a wrong encoding, a
+size that disagrees with CameraInfo or a frame nobody publishes tf for are rejected and counted
+without stopping the node; ~clear empties the map and deletes the markers.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from diagnostic_msgs.msg import DiagnosticArray
+from sensor_msgs.msg import CameraInfo, Image
+from std_msgs.msg import Bool, Header
+from std_srvs.srv import Empty
+from visualization_msgs.msg import Marker, MarkerArray
+
+from downstream_perception.ros_util import wait_until
+from downstream_perception.sim.depth_camera import room_scene
+from downstream_perception.srv import SaveMap
+
+
+class TsdfRoomTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node("test_tsdf_room")
+        cls.blocks: dict[int, np.ndarray] = {}  # marker id -> (3 n, 3) triangle corners
+        cls.mesh_messages = 0
+        cls.deleted_all = False
+        cls.status: dict[str, str] = {}
+        cls.done = False
+
+        def on_mesh(msg: MarkerArray) -> None:
+            for m in msg.markers:
+                if m.action == Marker.DELETEALL:
+                    cls.blocks.clear()
+                    cls.deleted_all = True
+                elif m.action == Marker.DELETE:
+                    cls.blocks.pop(m.id, None)
+                else:
+                    cls.blocks[m.id] = np.array([[p.x, p.y, p.z] for p in m.points])
+            cls.mesh_messages += 1
+
+        def on_diag(msg: DiagnosticArray) -> None:
+            for s in msg.status:
+                if s.name.endswith("tsdf: tsdf"):
+                    cls.status = {kv.key: kv.value for kv in s.values}
+
+        def on_done(msg: Bool) -> None:
+            cls.done = cls.done or msg.data
+
+        rospy.Subscriber("/tsdf/mesh", MarkerArray, on_mesh, queue_size=20)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
+        rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
+
+    def test_1_mesh_lies_on_the_true_surfaces(self) -> None:
+        self.assertTrue(wait_until(lambda: self.done, 40.0), "the simulator did not finish")
+        time.sleep(1.5)  # the next mesh update (2 Hz) after the last frame
+        self.assertGreater(self.mesh_messages, 0)
+        self.assertEqual(int(self.status.get("frames integrated", 0)), 20, self.status)
+        corners = np.vstack(list(self.blocks.values()))
+        self.assertGreater(len(corners), 30000)
+        error = np.abs(room_scene().signed_distance(corners))
+        # 4 cm voxels: sub-voxel surfaces (the 320x240 2 cm figures are 0.7 mm mean).
+        self.assertLess(float(error.mean()), 0.003)
+        self.assertLess(float(np.percentile(error, 99)), 0.04)
+        self.assertLess(float(np.mean(error > 0.04)), 0.005)  # ghosts: more than a voxel off
+
+    def test_2_save_mesh_writes_a_ply(self) -> None:
+        rospy.wait_for_service("/tsdf/save_mesh", 5.0)
+        save = rospy.ServiceProxy("/tsdf/save_mesh", SaveMap)
+        path = os.path.join(tempfile.mkdtemp(), "room.ply")
+        reply = save(path)
+        self.assertTrue(reply.success, reply.message)
+        with open(path, "rb") as f:
+            header = f.read(400).split(b"end_header")[0].decode()
+        vertices = int(header.split("element vertex ")[1].split()[0])
+        self.assertGreater(vertices, 10000)
+        self.assertIn(f"wrote {vertices} vertices", reply.message)
+        refused = save(os.path.join(tempfile.mkdtemp(), "room.obj"))
+        self.assertFalse(refused.success)
+        self.assertIn(".ply", refused.message)
+
+    def test_3_bad_frames_are_counted_and_survived(self) -> None:
+        images = rospy.Publisher("/depth/image", Image, queue_size=50)
+        infos = rospy.Publisher("/depth/camera_info", CameraInfo, queue_size=50)
+        time.sleep(1.0)
+        now = rospy.Time.now()
+        rgb = Image(header=Header(stamp=now, frame_id="depth_optical"), height=2, width=2)
+        rgb.encoding, rgb.step, rgb.data = "rgb8", 6, bytes(12)
+        images.publish(rgb)
+        small = Image(header=Header(stamp=now, frame_id="depth_optical"), height=10, width=10)
+        small.encoding, small.step, small.data = "32FC1", 40, bytes(400)
+        images.publish(small)  # CameraInfo for depth_optical says 320 x 240
+        # A camera whose frame nobody publishes tf for: its (valid) frames wait for tf until the
+        # queue (10) overflows.
+        k = [100.0, 0.0, 1.0, 0.0, 100.0, 1.0, 0.0, 0.0, 1.0]
+        infos.publish(
+            CameraInfo(header=Header(stamp=now, frame_id="nowhere"), width=2, height=2, K=k)
+        )
+        time.sleep(0.5)
+        for _ in range(15):
+            lost = Image(header=Header(stamp=rospy.Time.now(), frame_id="nowhere"), height=2)
+            lost.width, lost.encoding, lost.step, lost.data = 2, "32FC1", 8, bytes(16)
+            images.publish(lost)
+            time.sleep(0.02)
+        self.assertTrue(
+            wait_until(
+                lambda: int(self.status.get("rejected (bad depth image)", 0)) >= 1
+                and int(self.status.get("rejected (camera_info missing or inconsistent)", 0)) >= 1
+                and any(k.startswith("rejected (tf") for k in self.status),
+                15.0,
+            ),
+            f"diagnostics: {self.status}",
+        )
+        self.assertEqual(int(self.status["frames integrated"]), 20)
+
+    def test_4_clear_empties_the_map(self) -> None:
+        rospy.wait_for_service("/tsdf/clear", 5.0)
+        rospy.ServiceProxy("/tsdf/clear", Empty)()
+        self.assertTrue(wait_until(lambda: self.deleted_all, 5.0), "DELETEALL marker")
+        self.assertTrue(wait_until(lambda: int(self.status.get("blocks", -1)) == 0, 5.0))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("downstream_perception", "test_tsdf_room", TsdfRoomTest)
