@@ -4,13 +4,16 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "downstream_perception/core/grid_geometry.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
 
 namespace py = pybind11;
 using namespace downstream_perception;  // NOLINT
@@ -183,6 +186,26 @@ void bindTsdf(py::module& m) {
             if (!why.empty()) throw std::runtime_error(why);
           },
           py::arg("path"))
+      .def(
+          "slice",
+          [](const Tsdf& self, const GridGeometry& grid, double min_z_m, double max_z_m,
+             double occupied_distance_m) {
+            TsdfSliceConfig c;
+            c.min_z_m = min_z_m;
+            c.max_z_m = max_z_m;
+            c.occupied_distance_m = occupied_distance_m;
+            const std::vector<SliceCell> cells = sliceTsdf(self.map, grid, c);
+            py::array_t<std::int8_t> out(
+                {static_cast<py::ssize_t>(grid.sizeY()), static_cast<py::ssize_t>(grid.sizeX())});
+            std::transform(cells.begin(), cells.end(), out.mutable_data(),
+                           [](SliceCell v) { return static_cast<std::int8_t>(v); });
+            return out;
+          },
+          py::arg("grid"), py::arg("min_z_m") = 0.05, py::arg("max_z_m") = 1.8,
+          py::arg("occupied_distance_m") = -1.0,
+          "2-D slice over grid ([y, x] int8: 1 occupied, 0 free, -1 unknown): a cell is occupied "
+          "when a voxel in the height band (m) over it is within occupied_distance_m of a "
+          "surface or inside (default one voxel).")
       .def_property_readonly("block_count", [](const Tsdf& t) { return t.map.blockCount(); })
       .def_property_readonly("memory_bytes", [](const Tsdf& t) { return t.map.memoryBytes(); })
       .def("clear", [](Tsdf& self) {

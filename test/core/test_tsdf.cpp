@@ -13,6 +13,7 @@
 #include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
 
 using namespace downstream_perception;
 
@@ -354,4 +355,52 @@ TEST(MarchingCubes, MesherReExtractsOnlyChangedBlocks) {
   const std::size_t second = mesher.update(map);
   EXPECT_GT(second, 0u);
   EXPECT_LT(second, first / 4);
+}
+
+TEST(TsdfSlice, TableTopInTheBandIsAnObstacleTheFloorIsNot) {
+  // Exact SDF of a floor (z = 0) and a table top (z 0.72 .. 0.76 over x 1 .. 2, |y| <= 0.5),
+  // observed within x, y in [-1, 3) x [-1, 1), z in [-0.2, 1.2].
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  TsdfMap map(c);
+  const double mu = c.truncation();
+  const auto slab = [](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d q =
+        (p - Eigen::Vector3d(1.5, 0.0, 0.74)).cwiseAbs() - Eigen::Vector3d(0.5, 0.5, 0.02);
+    return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+  };
+  for (int z = -4; z <= 24; ++z) {
+    for (int y = -20; y < 20; ++y) {
+      for (int x = -20; x < 60; ++x) {
+        const Eigen::Vector3i v(x, y, z);
+        const Eigen::Vector3d p = map.voxelCenter(v);
+        const double sdf = std::min(p.z(), slab(p));
+        TsdfVoxel& voxel = map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
+        voxel.distance = static_cast<float>(std::clamp(sdf / mu, -1.0, 1.0));
+        voxel.weight = 1.0f;
+      }
+    }
+  }
+  // Voxel centres on the cell edges: each must still land in a cell of its own.
+  const GridGeometry grid(100, 60, 0.05, -2.0, -1.5);
+  TsdfSliceConfig band;  // 0.05 .. 1.8 m
+  TsdfSliceStats stats;
+  const std::vector<SliceCell> slice = sliceTsdf(map, grid, band, &stats);
+  const auto at = [&](double x, double y) {
+    const CellIndex cell = grid.worldToCellUnbounded(x, y);
+    return slice[grid.index(cell.x, cell.y)];
+  };
+  EXPECT_EQ(at(1.5, 0.0), SliceCell::kOccupied);    // under the table top
+  EXPECT_EQ(at(1.02, 0.48), SliceCell::kOccupied);  // its corner
+  EXPECT_EQ(at(0.0, 0.0), SliceCell::kFree);        // floor only: below the band
+  EXPECT_EQ(at(2.2, 0.0), SliceCell::kFree);        // beside the table, beyond one voxel
+  EXPECT_EQ(at(-1.8, 1.3), SliceCell::kUnknown);    // never observed
+  EXPECT_EQ(stats.cells_occupied, 21u * 21u);       // 1 .. 2 m in 5 cm cells, edges included
+  // A band above the table: it is gone from the slice.
+  band.min_z_m = 0.9;
+  EXPECT_EQ(sliceTsdf(map, grid, band)[grid.index(grid.worldToCellUnbounded(1.5, 0.0).x,
+                                                  grid.worldToCellUnbounded(1.5, 0.0).y)],
+            SliceCell::kFree);
+  band.max_z_m = 0.5;  // below min_z_m
+  EXPECT_THROW(sliceTsdf(map, grid, band), std::invalid_argument);
 }

@@ -166,3 +166,32 @@ def test_depth_camera_renders_exact_depths() -> None:
     rays = cam.rays() * depth.reshape(-1, 1)
     hits = rays @ pose[:3, :3].T + pose[:3, 3]
     np.testing.assert_allclose(scene.signed_distance(hits), 0.0, atol=1e-6)
+
+
+def test_slice_puts_the_table_top_into_the_grid() -> None:
+    # The room's objects in the 0.05-1.8 m band become obstacles in a 5 cm grid, including the
+    # table top (0.72-0.76 m, floating: a 2-D lidar under it would see nothing) and the sphere
+    # (0.9-1.5 m); the open floor is free; outside the room is unknown.
+    cam = DepthCamera()
+    scene, poses, depths, _ = room_frames(cam)
+    config = dp.TsdfConfig()
+    config.voxel_size_m = 0.05
+    tsdf = dp.Tsdf(config)
+    for pose, depth in zip(poses, depths, strict=True):
+        tsdf.integrate_depth(depth, camera(cam), pose)
+    grid = dp.GridGeometry(100, 100, 0.05, -2.5, -2.5)
+    cells = tsdf.slice(grid, 0.05, 1.8)
+    assert cells.shape == (100, 100)
+
+    def at(x: float, y: float) -> int:
+        return int(cells[int((y + 2.5) / 0.05), int((x + 2.5) / 0.05)])
+
+    table, box, sphere = scene.boxes[1].center, scene.boxes[0].center, scene.spheres[0].center
+    assert at(table[0], table[1]) == 1
+    assert at(box[0], box[1]) == 1
+    assert at(sphere[0], sphere[1]) == 1
+    assert at(0.0, 1.3) == 0  # open floor
+    assert at(-2.4, -2.4) == -1  # outside the room
+    # Above the table and below the sphere: the table is gone, the sphere too.
+    above = tsdf.slice(grid, 0.8, 0.85)
+    assert above[int((table[1] + 2.5) / 0.05), int((table[0] + 2.5) / 0.05)] == 0

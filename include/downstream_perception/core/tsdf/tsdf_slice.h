@@ -1,0 +1,37 @@
+// A 2-D slice of the TSDF for planning: every grid cell over which some observed voxel in a
+// height band lies on or inside a surface is occupied (a table top within the robot's height
+// reaches the costmap even though a 2-D lidar under it sees nothing), cells with only free
+// voxels in the band are free, the rest unknown.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+
+namespace downstream_perception {
+
+struct TsdfSliceConfig {
+  double min_z_m = 0.05;  ///< band bottom (map frame): above the floor
+  double max_z_m = 1.8;   ///< band top: the robot's height
+  /// A voxel whose signed distance is below this counts as occupied (m; negative = inside).
+  /// Default: one voxel, so the surface shell itself is an obstacle.
+  double occupied_distance_m = -1.0;  ///< < 0: use the voxel size
+  std::string validate() const;
+};
+
+enum class SliceCell : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 1 };
+
+struct TsdfSliceStats {
+  std::size_t voxels_in_band = 0;
+  std::size_t cells_occupied = 0;
+  std::size_t cells_free = 0;
+};
+
+/// The slice over `grid` (row-major, grid.index(x, y)); voxels are binned by their centre.
+std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
+                                 const TsdfSliceConfig& config, TsdfSliceStats* stats = nullptr);
+
+}  // namespace downstream_perception

@@ -1,0 +1,68 @@
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace downstream_perception {
+
+std::string TsdfSliceConfig::validate() const {
+  std::ostringstream why;
+  if (!(std::isfinite(min_z_m) && std::isfinite(max_z_m) && min_z_m < max_z_m)) {
+    why << "need finite min_z_m < max_z_m, got " << min_z_m << " and " << max_z_m;
+  } else if (!std::isfinite(occupied_distance_m)) {
+    why << "occupied_distance_m must be finite";
+  }
+  return why.str();
+}
+
+std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
+                                 const TsdfSliceConfig& config, TsdfSliceStats* stats) {
+  const std::string why = config.validate();
+  if (!why.empty()) throw std::invalid_argument("tsdf slice: " + why);
+  std::vector<SliceCell> cells(static_cast<std::size_t>(grid.sizeX()) * grid.sizeY(),
+                               SliceCell::kUnknown);
+  TsdfSliceStats local;
+  const double s = map.voxelSize();
+  const double mu = map.config().truncation();
+  const float min_weight = static_cast<float>(map.config().min_weight);
+  const float occupied_below =
+      static_cast<float>((config.occupied_distance_m < 0.0 ? s : config.occupied_distance_m) / mu);
+  // Voxel z indices in the band (centres at k * s).
+  const int k_min = static_cast<int>(std::ceil(config.min_z_m / s));
+  const int k_max = static_cast<int>(std::floor(config.max_z_m / s));
+  for (const auto& [key, block] : map.blocks()) {
+    const int z0 = key.z() * kTsdfBlockSide;
+    if (z0 + kTsdfBlockSide - 1 < k_min || z0 > k_max) continue;
+    for (int z = std::max(0, k_min - z0); z < kTsdfBlockSide && z0 + z <= k_max; ++z) {
+      for (int y = 0; y < kTsdfBlockSide; ++y) {
+        for (int x = 0; x < kTsdfBlockSide; ++x) {
+          const TsdfVoxel& v = block->voxels[TsdfBlock::linear(x, y, z)];
+          if (!(v.weight > min_weight)) continue;
+          // Voxel centres often lie exactly on cell edges (same resolution, origin on the
+          // lattice); a nudge of 1e-4 voxel breaks the tie the same way for every voxel, so no
+          // cell is skipped through rounding.
+          const double wx = (key.x() * kTsdfBlockSide + x) * s + 1e-4 * s;
+          const double wy = (key.y() * kTsdfBlockSide + y) * s + 1e-4 * s;
+          const CellIndex c = grid.worldToCellUnbounded(wx, wy);
+          if (!grid.inBounds(c.x, c.y)) continue;
+          ++local.voxels_in_band;
+          SliceCell& cell = cells[grid.index(c.x, c.y)];
+          if (v.distance < occupied_below) {
+            cell = SliceCell::kOccupied;
+          } else if (cell == SliceCell::kUnknown) {
+            cell = SliceCell::kFree;
+          }
+        }
+      }
+    }
+  }
+  for (const SliceCell c : cells) {
+    local.cells_occupied += c == SliceCell::kOccupied;
+    local.cells_free += c == SliceCell::kFree;
+  }
+  if (stats != nullptr) *stats = local;
+  return cells;
+}
+
+}  // namespace downstream_perception
