@@ -24,6 +24,7 @@
 
 #include "downstream_perception/SaveMap.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/running_stats.h"
@@ -91,6 +92,9 @@ class TsdfRos {
   RunningStats integrate_ms_;
   RunningStats mesh_ms_;
   std::size_t mesh_triangles_ = 0;
+  double health_period_s_ = 10.0;
+  ros::Time last_health_;
+  TsdfHealth health_;
   std::vector<std::string> config_errors_;
 };
 

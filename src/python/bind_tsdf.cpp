@@ -11,6 +11,7 @@
 
 #include "downstream_perception/core/grid_geometry.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
@@ -206,6 +207,19 @@ void bindTsdf(py::module& m) {
           "2-D slice over grid ([y, x] int8: 1 occupied, 0 free, -1 unknown): a cell is occupied "
           "when a voxel in the height band (m) over it is within occupied_distance_m of a "
           "surface or inside (default one voxel).")
+      .def(
+          "health",
+          [](const Tsdf& self) {
+            const TsdfHealth h = tsdfHealth(self.map);
+            py::dict out;
+            out["crossings"] = h.crossings;
+            out["mean_gradient_ratio"] = h.mean_gradient_ratio;
+            out["low_gradient_fraction"] = h.low_gradient_fraction;
+            out["double_crossings"] = h.double_crossings;
+            return out;
+          },
+          "The lesson's health check: at zero crossings |grad (D mu)| (1 = clean), the share "
+          "below 0.5, and double crossings within mu (pose drift's fingerprint).")
       .def_property_readonly("block_count", [](const Tsdf& t) { return t.map.blockCount(); })
       .def_property_readonly("memory_bytes", [](const Tsdf& t) { return t.map.memoryBytes(); })
       .def("clear", [](Tsdf& self) {

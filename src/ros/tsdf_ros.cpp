@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "downstream_perception/config_errors.h"
+#include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/tsdf_params.h"
 
 namespace downstream_perception {
@@ -79,6 +80,12 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
                              " must be in (0, 100] Hz; using 1");
     ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
     mesh_rate_hz = 1.0;
+  }
+  pnh_.param("health_period_s", health_period_s_, health_period_s_);
+  if (!(std::isfinite(health_period_s_) && health_period_s_ >= 0.0)) {
+    config_errors_.push_back("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
+    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    health_period_s_ = 10.0;
   }
   int tf_queue_size = 10;
   pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
@@ -304,6 +311,13 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
     markers = markers_.changed(mesher_, header);
     mesh_triangles_ = 0;
     for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
+    // The health check walks the whole map (tens of ms): every health_period_s at most.
+    const ros::Time now = ros::Time::now();
+    if (health_period_s_ > 0.0 && !mesher_.lastUpdated().empty() &&
+        (last_health_.isZero() || (now - last_health_).toSec() >= health_period_s_)) {
+      health_ = tsdfHealth(*map_);
+      last_health_ = now;
+    }
   }
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
   diagnostics_.update();
@@ -371,6 +385,13 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("blocks evicted by distance (total)", blocks_evicted_);
   status.add("mesh triangles", mesh_triangles_);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());
+  if (!last_health_.isZero()) {
+    status.add("health: zero crossings", health_.crossings);
+    status.add("health: mean |grad(D mu)| (1 = true distances; oblique views read 1/cos)",
+               health_.mean_gradient_ratio);
+    status.add("health: double crossings within mu (drift or thin objects)",
+               health_.double_crossings);
+  }
   addConfigErrors(status, config_errors_);
   if (!config_errors_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());

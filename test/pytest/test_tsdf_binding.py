@@ -119,6 +119,11 @@ def test_room_mesh_accuracy(image: str, voxel: float, tmp_path: Path) -> None:
     score = score_mesh(scene, mesh["vertices"], mesh["triangles"], voxel, observed)
     print(image, voxel, score.row())
     mean_bar, completeness_bar, ghost_bar = BARS[(image, voxel)]
+    health = tsdf.health()
+    assert health["crossings"] > 1000
+    # Projective distances from oblique views read about 1/cos of the view angle (> 1).
+    assert 1.0 < health["mean_gradient_ratio"] < 2.5
+    assert health["double_crossings"] < 0.05 * health["crossings"]
     assert score.mean_error_m <= mean_bar
     assert score.completeness >= completeness_bar
     assert score.ghost_fraction < ghost_bar

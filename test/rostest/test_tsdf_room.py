@@ -66,6 +66,7 @@ class TsdfRoomTest(unittest.TestCase):
         time.sleep(1.5)  # the next mesh update (2 Hz) after the last frame
         self.assertGreater(self.mesh_messages, 0)
         self.assertEqual(int(self.status.get("frames integrated", 0)), 20, self.status)
+        self.assertGreater(int(self.status.get("health: zero crossings", 0)), 1000, self.status)
         corners = np.vstack(list(self.blocks.values()))
         self.assertGreater(len(corners), 30000)
         error = np.abs(room_scene().signed_distance(corners))
