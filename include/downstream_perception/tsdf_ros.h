@@ -50,8 +50,11 @@ class TsdfRos {
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
   /// The pinhole model for an image from the latest CameraInfo of its frame, or why not.
   bool cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why);
-  void onTfFailure(const std::string& what, const std_msgs::Header& header,
-                   tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  /// A MessageFilter into world_frame_ calling on_ready, and reject() with the reason on a drop.
+  template <class M>
+  std::unique_ptr<tf2_ros::MessageFilter<M>> tfFilter(
+      void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&), const std::string& what,
+      std::uint32_t queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
   bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);

@@ -2,20 +2,9 @@
 
 #include <sstream>
 
-namespace downstream_perception {
+#include "downstream_perception/tf_failure.h"
 
-namespace {
-const char* reasonName(tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-  switch (reason) {
-    case tf2_ros::filter_failure_reasons::OutTheBack:
-      return "tf: older than the transform cache";
-    case tf2_ros::filter_failure_reasons::EmptyFrameID:
-      return "tf: empty frame_id";
-    default:
-      return "tf: no transform in time (queue overflow: unknown frame or late tf)";
-  }
-}
-}  // namespace
+namespace downstream_perception {
 
 ObservationSource::ObservationSource(std::string name, const ObservationSourceConfig& config,
                                      ros::NodeHandle nh, tf2_ros::Buffer& tf,
@@ -58,7 +47,7 @@ void ObservationSource::onTfFailure(const std::string& frame, const ros::Time& s
   }
   std::ostringstream detail;
   detail << "frame '" << frame << "' -> '" << global_frame_ << "' at stamp " << stamp;
-  reject(reasonName(reason), detail.str());
+  reject(tfFailureReason(reason), detail.str());
 }
 
 bool ObservationSource::lookup(const std::string& frame, const ros::Time& stamp,

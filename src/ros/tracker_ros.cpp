@@ -12,6 +12,7 @@
 
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/config_errors.h"
+#include "downstream_perception/tf_failure.h"
 
 namespace downstream_perception {
 
@@ -116,10 +117,7 @@ void TrackerRos::onTfFailure(const DetectedObjectArrayConstPtr& msg,
   std::ostringstream detail;
   detail << "frame '" << msg->header.frame_id << "' -> '" << tracking_frame_ << "' at stamp "
          << msg->header.stamp;
-  reject(reason == tf2_ros::filter_failure_reasons::OutTheBack
-             ? "tf: older than the transform cache"
-             : "tf: no transform in time (unknown frame or late tf)",
-         detail.str());
+  reject(tfFailureReason(reason), detail.str());
 }
 
 bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* out,

@@ -10,6 +10,7 @@
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
+#include "downstream_perception/tf_failure.h"
 #include "downstream_perception/tsdf_params.h"
 
 namespace downstream_perception {
@@ -70,6 +71,22 @@ bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* met
   return true;
 }
 
+template <class M>
+std::unique_ptr<tf2_ros::MessageFilter<M>> TsdfRos::tfFilter(
+    void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&), const std::string& what,
+    std::uint32_t queue) {
+  auto filter = std::make_unique<tf2_ros::MessageFilter<M>>(*tf_buffer_, world_frame_, queue, nh_);
+  filter->registerCallback(boost::bind(on_ready, this, boost::placeholders::_1));
+  filter->registerFailureCallback(
+      [this, what](const boost::shared_ptr<const M>& m,
+                   tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+        std::ostringstream detail;
+        detail << what << " in '" << m->header.frame_id << "' at stamp " << m->header.stamp;
+        reject(tfFailureReason(reason), detail.str());
+      });
+  return filter;
+}
+
 TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
   pnh_.param("world_frame", world_frame_, std::string("odom"));
@@ -109,23 +126,9 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   // Raw subscribers check each message first (a wrong encoding is reported at once instead of
   // waiting for tf) and pass it to a tf2 MessageFilter, which holds it until the transform to
   // the world frame at its stamp exists.
-  depth_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::Image>>(
-      *tf_buffer_, world_frame_, queue, nh_);
-  depth_filter_->registerCallback(boost::bind(&TsdfRos::onDepth, this, boost::placeholders::_1));
-  depth_filter_->registerFailureCallback(
-      [this](const sensor_msgs::ImageConstPtr& m,
-             tf2_ros::filter_failure_reasons::FilterFailureReason r) {
-        onTfFailure("depth image", m->header, r);
-      });
+  depth_filter_ = tfFilter<sensor_msgs::Image>(&TsdfRos::onDepth, "depth image", queue);
   depth_subscriber_ = nh_.subscribe("depth/image", 5, &TsdfRos::onDepthRaw, this);
-  cloud_filter_ = std::make_unique<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>>(
-      *tf_buffer_, world_frame_, queue, nh_);
-  cloud_filter_->registerCallback(boost::bind(&TsdfRos::onCloud, this, boost::placeholders::_1));
-  cloud_filter_->registerFailureCallback(
-      [this](const sensor_msgs::PointCloud2ConstPtr& m,
-             tf2_ros::filter_failure_reasons::FilterFailureReason r) {
-        onTfFailure("point cloud", m->header, r);
-      });
+  cloud_filter_ = tfFilter<sensor_msgs::PointCloud2>(&TsdfRos::onCloud, "point cloud", queue);
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
   mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
   const TsdfConfig& c = map_->config();
@@ -149,16 +152,6 @@ void TsdfRos::reject(const std::string& reason, const std::string& detail) {
     ++rejected_[reason];
   }
   ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s: %s", reason.c_str(), detail.c_str());
-}
-
-void TsdfRos::onTfFailure(const std::string& what, const std_msgs::Header& header,
-                          tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-  std::ostringstream detail;
-  detail << what << " in '" << header.frame_id << "' at stamp " << header.stamp;
-  reject(reason == tf2_ros::filter_failure_reasons::OutTheBack
-             ? "tf: older than the transform cache"
-             : "tf: no transform in time (unknown frame or late tf)",
-         detail.str());
 }
 
 bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::string* why) {

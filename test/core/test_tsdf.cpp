@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <random>
@@ -58,6 +59,56 @@ PinholeCamera smallCamera() {
   c.cx = 79.5;
   c.cy = 59.5;
   return c;
+}
+
+// Writes D = value(voxel centre) with weight 1 into every voxel of [lo, hi] (inclusive; NaN
+// skips the voxel), then marks every block as changed by one integration.
+void fill(TsdfMap* map, const Eigen::Vector3i& lo, const Eigen::Vector3i& hi,
+          const std::function<double(const Eigen::Vector3d&)>& value) {
+  for (int z = lo.z(); z <= hi.z(); ++z) {
+    for (int y = lo.y(); y <= hi.y(); ++y) {
+      for (int x = lo.x(); x <= hi.x(); ++x) {
+        const Eigen::Vector3i v(x, y, z);
+        const double d = value(map->voxelCenter(v));
+        if (std::isnan(d)) continue;
+        TsdfVoxel& voxel = map->allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
+        voxel.distance = static_cast<float>(d);
+        voxel.weight = 1.0f;
+      }
+    }
+  }
+  const std::uint64_t generation = map->beginIntegration();
+  for (const auto& kv : map->blocks()) kv.second->updated_stamp = generation;
+}
+
+TriangleMesh meshOf(const TsdfMap& map) {
+  TsdfMesher mesher;
+  mesher.update(map);
+  return mesher.combined();
+}
+
+// Mesh vertices merged by position (block seams duplicate them, bit-identically) and the count
+// of each directed edge over the merged ids.
+struct MeshEdges {
+  std::vector<int> id;
+  std::size_t vertices = 0;
+  std::map<std::pair<int, int>, int> directed;
+};
+MeshEdges meshEdges(const TriangleMesh& mesh) {
+  MeshEdges e;
+  std::map<std::tuple<float, float, float>, int> id_of;
+  for (const Eigen::Vector3f& p : mesh.vertices) {
+    e.id.push_back(
+        id_of.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(id_of.size()))
+            .first->second);
+  }
+  e.vertices = id_of.size();
+  for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      ++e.directed[{e.id[mesh.triangles[3 * t + k]], e.id[mesh.triangles[3 * t + (k + 1) % 3]]}];
+    }
+  }
+  return e;
 }
 
 }  // namespace
@@ -225,58 +276,34 @@ TEST(MarchingCubes, SphereIsClosedOrientedAndOnTheSurface) {
   TsdfMap map(c);
   const double mu = c.truncation(), radius = 0.37;
   const Eigen::Vector3d centre(0.013, -0.021, 0.007);
-  for (int z = -14; z <= 14; ++z) {
-    for (int y = -14; y <= 14; ++y) {
-      for (int x = -14; x <= 14; ++x) {
-        const Eigen::Vector3i v(x, y, z);
-        const double sdf = (map.voxelCenter(v) - centre).norm() - radius;
-        if (std::abs(sdf) > mu) continue;
-        TsdfBlock* b = map.allocate(TsdfMap::blockOf(v));
-        TsdfVoxel& voxel = b->voxels[TsdfMap::localIndex(v)];
-        voxel.distance = static_cast<float>(sdf / mu);
-        voxel.weight = 1.0f;
-      }
-    }
-  }
-  map.beginIntegration();
-  for (const auto& kv : map.blocks()) kv.second->updated_stamp = map.generation();
-  TsdfMesher mesher;
-  mesher.update(map);
-  const TriangleMesh mesh = mesher.combined();
+  fill(&map, Eigen::Vector3i::Constant(-14), Eigen::Vector3i::Constant(14),
+       [&](const Eigen::Vector3d& p) {
+         const double sdf = (p - centre).norm() - radius;
+         return std::abs(sdf) > mu ? std::nan("") : sdf / mu;
+       });
+  const TriangleMesh mesh = meshOf(map);
   ASSERT_GT(mesh.triangleCount(), 500u);
-  // Merge vertices on block seams by position, then count edges.
-  std::map<std::tuple<long, long, long>, int> id_of;
-  std::vector<int> merged(mesh.vertices.size());
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Eigen::Vector3f& p = mesh.vertices[i];
-    const auto key = std::make_tuple(std::lround(p.x() * 1e5), std::lround(p.y() * 1e5),
-                                     std::lround(p.z() * 1e5));
-    merged[i] = id_of.emplace(key, static_cast<int>(id_of.size())).first->second;
-    const Eigen::Vector3d q = p.cast<double>() - centre;
-    EXPECT_NEAR(q.norm(), radius, 0.004);  // within 4 mm at 5 cm voxels
+    const Eigen::Vector3d q = mesh.vertices[i].cast<double>() - centre;
+    EXPECT_NEAR(q.norm(), radius, 0.004);                                 // 4 mm at 5 cm voxels
     EXPECT_GT(mesh.normals[i].cast<double>().dot(q.normalized()), 0.98);  // outward
   }
-  std::map<std::pair<int, int>, int> directed;
   for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
-    const int a = merged[mesh.triangles[3 * t]], b = merged[mesh.triangles[3 * t + 1]],
-              d = merged[mesh.triangles[3 * t + 2]];
-    ++directed[{a, b}];
-    ++directed[{b, d}];
-    ++directed[{d, a}];
     // Winding agrees with the outward normal.
-    const Eigen::Vector3f n =
-        (mesh.vertices[mesh.triangles[3 * t + 1]] - mesh.vertices[mesh.triangles[3 * t]])
-            .cross(mesh.vertices[mesh.triangles[3 * t + 2]] - mesh.vertices[mesh.triangles[3 * t]]);
-    EXPECT_GT(n.dot(mesh.normals[mesh.triangles[3 * t]]), 0.0f);
+    const auto& v = mesh.vertices;
+    const std::uint32_t* tri = &mesh.triangles[3 * t];
+    const Eigen::Vector3f n = (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]);
+    EXPECT_GT(n.dot(mesh.normals[tri[0]]), 0.0f);
   }
   // Closed and consistently oriented: every directed edge once, its reverse once.
+  const MeshEdges edges = meshEdges(mesh);
   std::size_t undirected = 0;
-  for (const auto& [edge, count] : directed) {
+  for (const auto& [edge, count] : edges.directed) {
     EXPECT_EQ(count, 1);
-    EXPECT_EQ(directed.count({edge.second, edge.first}), 1u);
+    EXPECT_EQ(edges.directed.count({edge.second, edge.first}), 1u);
     undirected += edge.first < edge.second;
   }
-  const long euler = static_cast<long>(id_of.size()) - static_cast<long>(undirected) +
+  const long euler = static_cast<long>(edges.vertices) - static_cast<long>(undirected) +
                      static_cast<long>(mesh.triangleCount());
   EXPECT_EQ(euler, 2);
   EXPECT_EQ(mesh.writePly("/tmp/dp_sphere_test.ply"), "");
@@ -293,43 +320,25 @@ TEST(MarchingCubes, RandomFieldsGiveClosedOrientedSurfaces) {
     c.voxel_size_m = 0.1;
     TsdfMap map(c);
     const int n = 2 * kTsdfBlockSide;  // voxels 0 .. n-1 per axis filled
-    for (int z = 0; z < n; ++z) {
-      for (int y = 0; y < n; ++y) {
-        for (int x = 0; x < n; ++x) {
-          const Eigen::Vector3i v(x, y, z);
-          TsdfVoxel& voxel = map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
-          voxel.distance = trial == 2 ? 1e-7f * value(rng) : value(rng);  // trial 2: +-0 noise
-          voxel.weight = 1.0f;
-        }
-      }
-    }
-    map.beginIntegration();
-    for (const auto& kv : map.blocks()) kv.second->updated_stamp = map.generation();
-    TsdfMesher mesher;
-    mesher.update(map);
-    const TriangleMesh mesh = mesher.combined();
+    fill(&map, Eigen::Vector3i::Zero(), Eigen::Vector3i::Constant(n - 1),
+         [&](const Eigen::Vector3d&) {
+           return trial == 2 ? 1e-7 * value(rng) : value(rng);  // trial 2: +-0 noise
+         });
+    const TriangleMesh mesh = meshOf(map);
     ASSERT_GT(mesh.triangleCount(), 100u);
-    std::map<std::tuple<long, long, long>, int> id_of;
-    std::vector<int> merged(mesh.vertices.size());
-    std::vector<bool> interior(mesh.vertices.size());
+    const MeshEdges edges = meshEdges(mesh);
+    // Only edges whose cube lies fully inside the filled region (both ends off the region's
+    // faces by half a voxel) can be required to close.
+    std::vector<bool> interior(edges.vertices, false);
     for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
       const Eigen::Vector3f p = mesh.vertices[i] / 0.1f;  // voxel units
-      const auto key = std::make_tuple(std::lround(p.x() * 1e4), std::lround(p.y() * 1e4),
-                                       std::lround(p.z() * 1e4));
-      merged[i] = id_of.emplace(key, static_cast<int>(id_of.size())).first->second;
-      interior[i] = p.minCoeff() > 0.5f && p.maxCoeff() < n - 1.5f;  // off the region's faces
+      interior[edges.id[i]] = p.minCoeff() > 0.5f && p.maxCoeff() < n - 1.5f;
     }
-    std::map<std::pair<int, int>, int> directed;
     std::set<std::pair<int, int>> checked;
-    for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t a = mesh.triangles[3 * t + k], b = mesh.triangles[3 * t + (k + 1) % 3];
-        ++directed[{merged[a], merged[b]}];
-        // Only edges whose cube lies fully inside the filled region (both ends interior and
-        // off the outermost cube layer) can be required to close.
-        if (interior[a] && interior[b]) checked.insert({merged[a], merged[b]});
-      }
+    for (const auto& [edge, count] : edges.directed) {
+      if (interior[edge.first] && interior[edge.second]) checked.insert(edge);
     }
+    const auto& directed = edges.directed;
     std::size_t open = 0;
     for (const auto& e : checked) {
       const auto fwd = directed.find(e);
@@ -370,18 +379,10 @@ TEST(TsdfSlice, TableTopInTheBandIsAnObstacleTheFloorIsNot) {
         (p - Eigen::Vector3d(1.5, 0.0, 0.74)).cwiseAbs() - Eigen::Vector3d(0.5, 0.5, 0.02);
     return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
   };
-  for (int z = -4; z <= 24; ++z) {
-    for (int y = -20; y < 20; ++y) {
-      for (int x = -20; x < 60; ++x) {
-        const Eigen::Vector3i v(x, y, z);
-        const Eigen::Vector3d p = map.voxelCenter(v);
-        const double sdf = std::min(p.z(), slab(p));
-        TsdfVoxel& voxel = map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
-        voxel.distance = static_cast<float>(std::clamp(sdf / mu, -1.0, 1.0));
-        voxel.weight = 1.0f;
-      }
-    }
-  }
+  fill(&map, Eigen::Vector3i(-20, -20, -4), Eigen::Vector3i(59, 19, 24),
+       [&](const Eigen::Vector3d& p) {
+         return std::clamp(std::min(p.z(), slab(p)) / mu, -1.0, 1.0);
+       });
   // Voxel centres on the cell edges: each must still land in a cell of its own.
   const GridGeometry grid(100, 60, 0.05, -2.0, -1.5);
   TsdfSliceConfig band;  // 0.05 .. 1.8 m
