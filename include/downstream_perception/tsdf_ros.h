@@ -1,10 +1,12 @@
 // ROS host of the TSDF: depth images (+ CameraInfo) and/or point clouds in, each fused at its own
 // stamp in a fixed world frame (a tf2 MessageFilter holds a message until its transform exists);
-// the mesh out as per-block rviz markers at ~mesh_rate_hz; services to save the mesh and clear
+// the mesh out as per-block rviz markers and a height-band slice (OccupancyGrid, for the
+// TsdfLayer and rviz) at ~mesh_rate_hz; services to save the mesh and clear
 // the map; diagnostics. The nodelet and the node are thin shells around it.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -27,6 +29,7 @@
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/running_stats.h"
 #include "downstream_perception/tsdf_mesh_markers.h"
 
@@ -57,6 +60,8 @@ class TsdfRos {
       std::uint32_t queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
+  /// The height-band slice over the map's x-y extent (100 occupied, 0 free, -1 unknown).
+  nav_msgs::OccupancyGridPtr makeSlice(const std_msgs::Header& header);
   bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);
   bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -80,6 +85,9 @@ class TsdfRos {
   ros::Subscriber cloud_subscriber_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> cloud_filter_;
   ros::Publisher mesh_publisher_;
+  ros::Publisher slice_publisher_;
+  TsdfSliceConfig slice_;
+  TsdfSliceStats slice_stats_;
   ros::ServiceServer save_service_;
   ros::ServiceServer clear_service_;
   ros::Timer mesh_timer_;

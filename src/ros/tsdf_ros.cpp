@@ -10,6 +10,7 @@
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/tf_failure.h"
 #include "downstream_perception/tsdf_params.h"
 
@@ -104,6 +105,14 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
     health_period_s_ = 10.0;
   }
+  pnh_.param("slice_min_z_m", slice_.min_z_m, slice_.min_z_m);
+  pnh_.param("slice_max_z_m", slice_.max_z_m, slice_.max_z_m);
+  const std::string slice_why = slice_.validate();
+  if (!slice_why.empty()) {
+    config_errors_.push_back("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
+    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    slice_ = TsdfSliceConfig{};
+  }
   int tf_queue_size = 10;
   pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
   if (tf_queue_size < 1 || tf_queue_size > 1000) {
@@ -114,6 +123,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
 
   mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
+  slice_publisher_ = pnh_.advertise<nav_msgs::OccupancyGrid>("slice", 1, true);
   save_service_ = pnh_.advertiseService("save_mesh", &TsdfRos::saveMesh, this);
   clear_service_ = pnh_.advertiseService("clear", &TsdfRos::clear, this);
   diagnostics_.setHardwareID("tsdf " + world_frame_);
@@ -292,6 +302,7 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
 
 void TsdfRos::publishMesh(const ros::TimerEvent&) {
   visualization_msgs::MarkerArray markers;
+  nav_msgs::OccupancyGridPtr slice;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto t0 = std::chrono::steady_clock::now();
@@ -302,6 +313,7 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
     header.frame_id = world_frame_;
     header.stamp = ros::Time::now();
     markers = markers_.changed(mesher_, header);
+    if (!mesher_.lastUpdated().empty() || !markers.markers.empty()) slice = makeSlice(header);
     mesh_triangles_ = 0;
     for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
     // The health check walks the whole map (tens of ms): every health_period_s at most.
@@ -313,7 +325,30 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
     }
   }
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
+  if (slice) slice_publisher_.publish(slice);
   diagnostics_.update();
+}
+
+nav_msgs::OccupancyGridPtr TsdfRos::makeSlice(const std_msgs::Header& header) {
+  nav_msgs::OccupancyGridPtr grid(new nav_msgs::OccupancyGrid);
+  grid->header = header;
+  const GridGeometry geometry = sliceGeometry(*map_);
+  grid->info.map_load_time = header.stamp;
+  grid->info.resolution = static_cast<float>(geometry.resolution());
+  grid->info.width = static_cast<std::uint32_t>(geometry.sizeX());
+  grid->info.height = static_cast<std::uint32_t>(geometry.sizeY());
+  grid->info.origin.position.x = geometry.originX();
+  grid->info.origin.position.y = geometry.originY();
+  grid->info.origin.position.z = slice_.min_z_m;
+  grid->info.origin.orientation.w = 1.0;
+  if (geometry.sizeX() == 0) return grid;
+  const std::vector<SliceCell> cells = sliceTsdf(*map_, geometry, slice_, &slice_stats_);
+  grid->data.resize(cells.size());
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    grid->data[i] =
+        cells[i] == SliceCell::kOccupied ? 100 : (cells[i] == SliceCell::kFree ? 0 : -1);
+  }
+  return grid;
 }
 
 bool TsdfRos::saveMesh(SaveMap::Request& request, SaveMap::Response& response) {
@@ -377,6 +412,8 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("blocks refused at max_blocks (total)", blocks_refused_);
   status.add("blocks evicted by distance (total)", blocks_evicted_);
   status.add("mesh triangles", mesh_triangles_);
+  status.add("slice: occupied cells", slice_stats_.cells_occupied);
+  status.add("slice: free cells", slice_stats_.cells_free);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());
   if (!last_health_.isZero()) {
     status.add("health: zero crossings", health_.crossings);

@@ -1,6 +1,7 @@
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +15,20 @@ std::string TsdfSliceConfig::validate() const {
     why << "occupied_distance_m must be finite";
   }
   return why.str();
+}
+
+GridGeometry sliceGeometry(const TsdfMap& map) {
+  if (map.blockCount() == 0) return GridGeometry();
+  Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max());
+  Eigen::Vector2i hi = Eigen::Vector2i::Constant(std::numeric_limits<int>::min());
+  for (const auto& kv : map.blocks()) {
+    lo = lo.cwiseMin(kv.first.head<2>());
+    hi = hi.cwiseMax(kv.first.head<2>());
+  }
+  const double s = map.voxelSize();
+  return GridGeometry((hi.x() - lo.x() + 1) * kTsdfBlockSide,
+                      (hi.y() - lo.y() + 1) * kTsdfBlockSide, s,
+                      (lo.x() * kTsdfBlockSide - 0.5) * s, (lo.y() * kTsdfBlockSide - 0.5) * s);
 }
 
 std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,

@@ -30,6 +30,10 @@ struct TsdfSliceStats {
   std::size_t cells_free = 0;
 };
 
+/// A grid over the x-y extent of the allocated blocks with one cell per voxel column (voxel
+/// centres in the middle of the cells). Invalid (0 x 0) for an empty map.
+GridGeometry sliceGeometry(const TsdfMap& map);
+
 /// The slice over `grid` (row-major, grid.index(x, y)); voxels are binned by their centre.
 std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
                                  const TsdfSliceConfig& config, TsdfSliceStats* stats = nullptr);
