@@ -169,7 +169,7 @@ float interpolatedDepth(const DepthFrame& f, int w, int h, float uf, float vf, f
 /// Blocks the truncation band of the valid pixels passes through. Pixels are sampled every
 /// `stride` pixels, where a stride spans at most one voxel at the nearest depth of the frame
 /// (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the same
-/// block, so a one-entry cache skips most hash lookups.
+/// block, so a one-entry cache per sample along the ray skips most hash lookups.
 tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(const DepthFrame& f,
                                                            const PinholeCamera& camera,
                                                            const Eigen::Isometry3d& T,
@@ -185,7 +185,9 @@ tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(const DepthFrame& f,
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Vector3d t = T.translation();
   const int w = camera.width, h = camera.height;
-  Eigen::Vector3i last(std::numeric_limits<int>::min(), 0, 0);
+  // One cache per sample along the ray: neighbouring pixels' k-th samples share blocks.
+  std::vector<Eigen::Vector3i> last(samples,
+                                    Eigen::Vector3i(std::numeric_limits<int>::min(), 0, 0));
   const auto next = [stride](int a, int size) {
     // Every stride-th pixel and always the last one.
     return a + stride < size || a == size - 1 ? a + stride : size - 1;
@@ -202,8 +204,8 @@ tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(const DepthFrame& f,
       const double step = (range + mu - r0) / (samples - 1);
       for (int k = 0; k < samples; ++k) {
         const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), 1.0 / s);
-        if (key == last) continue;
-        last = key;
+        if (key == last[k]) continue;
+        last[k] = key;
         keys.insert(key);
       }
     }
