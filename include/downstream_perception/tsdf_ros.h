@@ -26,6 +26,7 @@
 
 #include "downstream_perception/SaveMap.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
@@ -62,6 +63,9 @@ class TsdfRos {
   void publishMesh(const ros::TimerEvent& event);
   /// The height-band slice over the map's x-y extent (100 occupied, 0 free, -1 unknown).
   nav_msgs::OccupancyGridPtr makeSlice(const std_msgs::Header& header);
+  /// Centres of the OctoMap's occupied leaves as a PointCloud2 (x, y, z) for rviz.
+  sensor_msgs::PointCloud2Ptr occupiedCloud(const std_msgs::Header& header);
+  bool saveOctomap(SaveMap::Request& request, SaveMap::Response& response);
   bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);
   bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -86,6 +90,12 @@ class TsdfRos {
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> cloud_filter_;
   ros::Publisher mesh_publisher_;
   ros::Publisher slice_publisher_;
+  ros::Publisher octomap_publisher_;
+  ros::ServiceServer save_octomap_service_;
+  std::unique_ptr<OccupancyOctree> octree_;  ///< null when ~octomap_resolution_m is 0
+  bool octree_changed_ = false;
+  std::size_t octree_occupied_ = 0;
+  RunningStats octree_ms_;
   TsdfSliceConfig slice_;
   TsdfSliceStats slice_stats_;
   ros::ServiceServer save_service_;

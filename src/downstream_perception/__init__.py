@@ -57,6 +57,8 @@ try:
         IntegrationStats,
         LogOddsConfig,
         LogOddsGrid,
+        OccupancyOctree,
+        OctreeConfig,
         PinholeCamera,
         Pose2D,
         ScanIntegrator,

@@ -5,12 +5,14 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "downstream_perception/core/grid_geometry.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
@@ -65,7 +67,85 @@ py::dict meshToDict(const TriangleMesh& mesh) {
 
 }  // namespace
 
+using PointsRows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+std::vector<Eigen::Vector3d> toPoints(const PointsRows& rows) {
+  std::vector<Eigen::Vector3d> out(rows.rows());
+  for (Eigen::Index i = 0; i < rows.rows(); ++i) out[i] = rows.row(i).transpose();
+  return out;
+}
+
+void bindOctree(py::module& m) {
+  py::class_<OctreeConfig>(m, "OctreeConfig")
+      .def(py::init<>())
+      .def_readwrite("resolution_m", &OctreeConfig::resolution_m)
+      .def_readwrite("prob_hit", &OctreeConfig::prob_hit)
+      .def_readwrite("prob_miss", &OctreeConfig::prob_miss)
+      .def_readwrite("max_range_m", &OctreeConfig::max_range_m)
+      .def_readwrite("depth_stride_px", &OctreeConfig::depth_stride_px)
+      .def("validate", &OctreeConfig::validate);
+  py::class_<OccupancyOctree>(m, "OccupancyOctree",
+                              "OctoMap occupancy (octomap::OcTree) from the same observations.")
+      .def(py::init<const OctreeConfig&>(), py::arg("config") = OctreeConfig{})
+      .def(
+          "insert_points",
+          [](OccupancyOctree& self, const PointsRows& points, const Eigen::Vector3d& origin) {
+            const auto p = toPoints(points);
+            py::gil_scoped_release release;
+            self.insertPoints(p, origin);
+          },
+          py::arg("points"), py::arg("origin"))
+      .def(
+          "insert_depth",
+          [](OccupancyOctree& self,
+             py::array_t<float, py::array::c_style | py::array::forcecast> depth,
+             const PinholeCamera& camera, const Eigen::Matrix4d& T_map_camera) {
+            if (depth.ndim() != 2 || depth.shape(0) != camera.height ||
+                depth.shape(1) != camera.width) {
+              throw std::invalid_argument("depth must be (height, width)");
+            }
+            const Eigen::Isometry3d pose = toIsometry(T_map_camera);
+            py::gil_scoped_release release;
+            self.insertDepth(depth.data(), camera, pose);
+          },
+          py::arg("depth"), py::arg("camera"), py::arg("T_map_camera"))
+      .def(
+          "log_odds",
+          [](const OccupancyOctree& self, const PointsRows& points) {
+            py::array_t<double> out(points.rows());
+            for (Eigen::Index i = 0; i < points.rows(); ++i) {
+              double l = std::nan("");
+              self.logOdds(points.row(i).transpose(), &l);
+              out.mutable_at(i) = l;
+            }
+            return out;
+          },
+          py::arg("points"), "Log-odds of the leaf at each point (NaN where never observed).")
+      .def(
+          "occupied",
+          [](const OccupancyOctree& self) {
+            const auto c = self.occupiedCenters();
+            py::array_t<double> out({static_cast<py::ssize_t>(c.size()), py::ssize_t{3}});
+            for (std::size_t i = 0; i < c.size(); ++i) {
+              for (int k = 0; k < 3; ++k) out.mutable_at(i, k) = c[i](k);
+            }
+            return out;
+          },
+          "Centres (N, 3) of the occupied leaves.")
+      .def(
+          "write_binary",
+          [](const OccupancyOctree& self, const std::string& path) {
+            const std::string why = self.writeBinary(path);
+            if (!why.empty()) throw std::runtime_error(why);
+          },
+          py::arg("path"))
+      .def_property_readonly("leaf_count", &OccupancyOctree::leafCount)
+      .def_property_readonly("memory_bytes", &OccupancyOctree::memoryBytes)
+      .def("clear", &OccupancyOctree::clear);
+}
+
 void bindTsdf(py::module& m) {
+  bindOctree(m);
   py::enum_<TsdfConfig::Weighting>(m, "TsdfWeighting")
       .value("CONSTANT", TsdfConfig::Weighting::kConstant)
       .value("INVERSE_SQUARE_DEPTH", TsdfConfig::Weighting::kInverseSquareDepth);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "downstream_perception/config_errors.h"
+#include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/tf_failure.h"
@@ -121,10 +122,27 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     tf_queue_size = 10;
   }
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
+  OctreeConfig octree;
+  pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
+  pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
+  octree.max_range_m = map_->config().max_depth_m;
+  if (octree.resolution_m > 0.0) {  // 0 turns the OctoMap off
+    const std::string why = octree.validate();
+    if (!why.empty()) {
+      config_errors_.push_back("OctoMap parameters invalid (" + why + "); using the defaults");
+      ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+      octree = OctreeConfig{};
+    }
+    octree_ = std::make_unique<OccupancyOctree>(octree);
+  }
 
   mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
   slice_publisher_ = pnh_.advertise<nav_msgs::OccupancyGrid>("slice", 1, true);
   save_service_ = pnh_.advertiseService("save_mesh", &TsdfRos::saveMesh, this);
+  if (octree_) {
+    octomap_publisher_ = pnh_.advertise<sensor_msgs::PointCloud2>("octomap_occupied", 1, true);
+    save_octomap_service_ = pnh_.advertiseService("save_octomap", &TsdfRos::saveOctomap, this);
+  }
   clear_service_ = pnh_.advertiseService("clear", &TsdfRos::clear, this);
   diagnostics_.setHardwareID("tsdf " + world_frame_);
   diagnostics_.add("tsdf", this, &TsdfRos::diagnose);
@@ -248,6 +266,13 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (octree_) {  // the same observation, as occupancy
+      const auto t1 = std::chrono::steady_clock::now();
+      octree_->insertDepth(metres.data(), camera, T_world_camera);
+      octree_changed_ = true;
+      octree_ms_.add(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
+    }
   }
   diagnostics_.update();
 }
@@ -296,6 +321,13 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (octree_) {  // the same observation, as occupancy
+      const auto t1 = std::chrono::steady_clock::now();
+      octree_->insertPoints(points, T_world_sensor.translation());
+      octree_changed_ = true;
+      octree_ms_.add(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
+    }
   }
   diagnostics_.update();
 }
@@ -303,6 +335,7 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
 void TsdfRos::publishMesh(const ros::TimerEvent&) {
   visualization_msgs::MarkerArray markers;
   nav_msgs::OccupancyGridPtr slice;
+  sensor_msgs::PointCloud2Ptr occupied;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto t0 = std::chrono::steady_clock::now();
@@ -314,6 +347,10 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
     header.stamp = ros::Time::now();
     markers = markers_.changed(mesher_, header);
     if (!mesher_.lastUpdated().empty() || !markers.markers.empty()) slice = makeSlice(header);
+    if (octree_ && octree_changed_) {
+      occupied = occupiedCloud(header);
+      octree_changed_ = false;
+    }
     mesh_triangles_ = 0;
     for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
     // The health check walks the whole map (tens of ms): every health_period_s at most.
@@ -326,7 +363,46 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   }
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
   if (slice) slice_publisher_.publish(slice);
+  if (occupied) octomap_publisher_.publish(occupied);
   diagnostics_.update();
+}
+
+sensor_msgs::PointCloud2Ptr TsdfRos::occupiedCloud(const std_msgs::Header& header) {
+  const std::vector<Eigen::Vector3d> centres = octree_->occupiedCenters();
+  sensor_msgs::PointCloud2Ptr cloud(new sensor_msgs::PointCloud2);
+  cloud->header = header;
+  sensor_msgs::PointCloud2Modifier modifier(*cloud);
+  modifier.setPointCloud2FieldsByString(1, "xyz");
+  modifier.resize(centres.size());
+  sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+  for (const Eigen::Vector3d& c : centres) {
+    *x = static_cast<float>(c.x());
+    *y = static_cast<float>(c.y());
+    *z = static_cast<float>(c.z());
+    ++x, ++y, ++z;
+  }
+  octree_occupied_ = centres.size();
+  return cloud;
+}
+
+bool TsdfRos::saveOctomap(SaveMap::Request& request, SaveMap::Response& response) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (request.path.size() < 4 || request.path.substr(request.path.size() - 3) != ".bt") {
+    response.success = false;
+    response.message = "only .bt is supported, got '" + request.path + "'";
+  } else {
+    const std::string why = octree_->writeBinary(request.path);
+    response.success = why.empty();
+    response.message =
+        why.empty() ? "wrote " + std::to_string(octree_->leafCount()) + " leaves to " + request.path
+                    : why;
+  }
+  if (response.success) {
+    ROS_INFO("tsdf: %s", response.message.c_str());
+  } else {
+    ROS_ERROR("tsdf: save_octomap failed: %s", response.message.c_str());
+  }
+  return true;
 }
 
 nav_msgs::OccupancyGridPtr TsdfRos::makeSlice(const std_msgs::Header& header) {
@@ -383,6 +459,10 @@ bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
     std::lock_guard<std::mutex> lock(mutex_);
     map_->clear();
     mesher_.clear();
+    if (octree_) {
+      octree_->clear();
+      octree_changed_ = true;
+    }
     std_msgs::Header header;
     header.frame_id = world_frame_;
     header.stamp = ros::Time::now();
@@ -413,6 +493,12 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("blocks evicted by distance (total)", blocks_evicted_);
   status.add("mesh triangles", mesh_triangles_);
   status.add("slice: occupied cells", slice_stats_.cells_occupied);
+  if (octree_) {
+    status.add("octomap: leaves", octree_->leafCount());
+    status.add("octomap: occupied leaves", octree_occupied_);
+    status.add("octomap: memory (MB)", static_cast<double>(octree_->memoryBytes()) / 1e6);
+    status.add("octomap: insertion time mean (ms)", octree_ms_.mean());
+  }
   status.add("slice: free cells", slice_stats_.cells_free);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());
   if (!last_health_.isZero()) {

@@ -200,3 +200,22 @@ def test_slice_puts_the_table_top_into_the_grid() -> None:
     # Above the table and below the sphere: the table is gone, the sphere too.
     above = tsdf.slice(grid, 0.8, 0.85)
     assert above[int((table[1] + 2.5) / 0.05), int((table[0] + 2.5) / 0.05)] == 0
+
+
+def test_octree_lesson_log_odds_and_room() -> None:
+    # One ray: the end leaf +0.847 (p_hit 0.7), a leaf on the way -0.405 (p_miss 0.4).
+    tree = dp.OccupancyOctree()
+    tree.insert_points(np.array([[1.01, 0.01, 0.01]]), np.array([0.01, 0.01, 0.01]))
+    log_odds = tree.log_odds(np.array([[1.01, 0.01, 0.01], [0.5, 0.01, 0.01], [0.5, 1.0, 0.0]]))
+    np.testing.assert_allclose(log_odds[:2], [np.log(0.7 / 0.3), np.log(0.4 / 0.6)], atol=1e-4)
+    assert np.isnan(log_odds[2])
+    # The room seen by the depth camera: occupied leaves lie on the true surfaces.
+    cam = DepthCamera()
+    scene = room_scene()
+    room = dp.OccupancyOctree()
+    for pose in circle_poses(10):
+        room.insert_depth(cam.render(scene, pose), camera(cam), pose)
+    occupied = room.occupied()
+    assert len(occupied) > 1000
+    # A 5 cm leaf's centre lies within half a diagonal (4.3 cm) of the surface it contains.
+    assert np.percentile(np.abs(scene.signed_distance(occupied)), 99) < 0.044

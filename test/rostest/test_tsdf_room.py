@@ -18,7 +18,8 @@ import numpy as np
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
-from sensor_msgs.msg import CameraInfo, Image
+from sensor_msgs import point_cloud2
+from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Bool, Header
 from std_srvs.srv import Empty
 from visualization_msgs.msg import Marker, MarkerArray
@@ -57,7 +58,13 @@ class TsdfRoomTest(unittest.TestCase):
         def on_done(msg: Bool) -> None:
             cls.done = cls.done or msg.data
 
+        cls.octomap: PointCloud2 | None = None
+
+        def on_octomap(msg: PointCloud2) -> None:
+            cls.octomap = msg
+
         rospy.Subscriber("/tsdf/mesh", MarkerArray, on_mesh, queue_size=20)
+        rospy.Subscriber("/tsdf/octomap_occupied", PointCloud2, on_octomap, queue_size=1)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
 
@@ -89,6 +96,21 @@ class TsdfRoomTest(unittest.TestCase):
         refused = save(os.path.join(tempfile.mkdtemp(), "room.obj"))
         self.assertFalse(refused.success)
         self.assertIn(".ply", refused.message)
+
+    def test_2b_octomap_is_published_and_saved(self) -> None:
+        self.assertIsNotNone(self.octomap, "no ~octomap_occupied cloud")
+        points = np.array(list(point_cloud2.read_points(self.octomap, ("x", "y", "z"))))
+        self.assertGreater(len(points), 1000)
+        # 5 cm leaves: a leaf centre lies within half a leaf diagonal of the surface it holds.
+        error = np.abs(room_scene().signed_distance(points))
+        self.assertLess(float(np.percentile(error, 99)), 0.044)
+        rospy.wait_for_service("/tsdf/save_octomap", 5.0)
+        save = rospy.ServiceProxy("/tsdf/save_octomap", SaveMap)
+        path = os.path.join(tempfile.mkdtemp(), "room.bt")
+        reply = save(path)
+        self.assertTrue(reply.success, reply.message)
+        with open(path, "rb") as f:
+            self.assertTrue(f.readline().startswith(b"# Octomap OcTree binary file"))
 
     def test_3_bad_frames_are_counted_and_survived(self) -> None:
         images = rospy.Publisher("/depth/image", Image, queue_size=50)
