@@ -449,7 +449,7 @@ TEST(OccupancyOctree, LessonLogOddsAlongARay) {
   ASSERT_TRUE(tree.logOdds(end[0], &l));
   EXPECT_NEAR(l, std::log(0.7 / 0.3), 1e-4);  // 0.847
   ASSERT_TRUE(tree.logOdds(Eigen::Vector3d(0.5, 0.01, 0.01), &l));
-  EXPECT_NEAR(l, std::log(0.4 / 0.6), 1e-4);  // -0.405
+  EXPECT_NEAR(l, std::log(0.4 / 0.6), 1e-4);                        // -0.405
   EXPECT_FALSE(tree.logOdds(Eigen::Vector3d(0.5, 1.0, 0.01), &l));  // never observed
   tree.insertPoints(end, Eigen::Vector3d(0.01, 0.01, 0.01));
   ASSERT_TRUE(tree.logOdds(end[0], &l));

@@ -41,13 +41,15 @@ void OccupancyOctree::insertPoints(const std::vector<Eigen::Vector3d>& points,
   octomap::Pointcloud cloud;
   cloud.reserve(points.size());
   for (const Eigen::Vector3d& p : points) {
-    if (p.allFinite()) cloud.push_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                                       static_cast<float>(p.z()));
+    if (p.allFinite())
+      cloud.push_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                      static_cast<float>(p.z()));
   }
-  tree_->insertPointCloud(cloud, octomap::point3d(static_cast<float>(origin.x()),
-                                                  static_cast<float>(origin.y()),
-                                                  static_cast<float>(origin.z())),
-                          config_.max_range_m);
+  tree_->insertPointCloud(
+      cloud,
+      octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
+                       static_cast<float>(origin.z())),
+      config_.max_range_m);
 }
 
 void OccupancyOctree::insertDepth(const float* depth, const PinholeCamera& camera,
@@ -80,13 +82,19 @@ std::vector<Eigen::Vector3d> OccupancyOctree::occupiedCenters() const {
   return out;
 }
 
-std::size_t OccupancyOctree::leafCount() const { return tree_->getNumLeafNodes(); }
-std::size_t OccupancyOctree::memoryBytes() const { return tree_->memoryUsage(); }
+std::size_t OccupancyOctree::leafCount() const {
+  return tree_->getNumLeafNodes();
+}
+std::size_t OccupancyOctree::memoryBytes() const {
+  return tree_->memoryUsage();
+}
 
 std::string OccupancyOctree::writeBinary(const std::string& path) const {
   return tree_->writeBinary(path) ? std::string() : "could not write " + path;
 }
 
-void OccupancyOctree::clear() { tree_->clear(); }
+void OccupancyOctree::clear() {
+  tree_->clear();
+}
 
 }  // namespace downstream_perception

@@ -21,8 +21,8 @@ namespace downstream_perception {
 
 struct OctreeConfig {
   double resolution_m = 0.05;
-  double prob_hit = 0.7;    ///< log-odds +0.847 per hit
-  double prob_miss = 0.4;   ///< log-odds -0.405 per pass
+  double prob_hit = 0.7;   ///< log-odds +0.847 per hit
+  double prob_miss = 0.4;  ///< log-odds -0.405 per pass
   double max_range_m = 10.0;
   int depth_stride_px = 4;  ///< depth images: every n-th pixel in each direction is a ray
   std::string validate() const;
