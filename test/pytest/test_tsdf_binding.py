@@ -219,3 +219,29 @@ def test_octree_lesson_log_odds_and_room() -> None:
     assert len(occupied) > 1000
     # A 5 cm leaf's centre lies within half a diagonal (4.3 cm) of the surface it contains.
     assert np.percentile(np.abs(scene.signed_distance(occupied)), 99) < 0.044
+
+
+def test_graceful_under_depth_and_pose_noise() -> None:
+    # 5 mm depth noise and 5 mm / 0.2 deg pose noise (frames rendered at the true pose, fused at
+    # the perturbed one): measured 3.3 mm mean, 0.22 % ghosts, 0.996 complete at 320x240 / 2 cm
+    # (Open3D legacy on the anchors' scene: 5.6 mm, 1.34 %, 0.988). The health check sees it.
+    from downstream_perception.sim.depth_camera import perturb_pose
+
+    cam = DepthCamera()
+    scene, poses, clean, observed = room_frames(cam)
+    depth_rng, pose_rng = np.random.default_rng(0), np.random.default_rng(1)
+    tsdf = dp.Tsdf()
+    for pose in poses:
+        depth = cam.render(scene, pose, depth_noise_m=0.005, rng=depth_rng)
+        drifted = perturb_pose(pose, 0.005, np.deg2rad(0.2), pose_rng)
+        tsdf.integrate_depth(depth, camera(cam), drifted)
+    tsdf.update_mesh()
+    mesh = tsdf.mesh()
+    score = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
+    assert score.mean_error_m < 0.005
+    assert score.ghost_fraction < 0.005
+    assert score.completeness > 0.99
+    reference = dp.Tsdf()
+    for pose, depth in zip(poses, clean, strict=True):
+        reference.integrate_depth(depth, camera(cam), pose)
+    assert tsdf.health()["double_crossings"] > 3 * reference.health()["double_crossings"]
