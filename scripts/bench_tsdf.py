@@ -29,8 +29,10 @@ def run(frames: int = 30) -> list[dict[str, Any]]:
     scene = room_scene()
     poses = circle_poses(frames)
     rows = []
+    frames = {}  # image name -> (camera, depths), reused by the OctoMap entry
     for name, cam in (("320x240", DepthCamera()), ("640x480", DepthCamera.vga())):
         depths = [cam.render(scene, T) for T in poses]
+        frames[name] = (cam, depths)
         observed = observed_samples(scene, cam, poses, depths)
         pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
         for voxel in (0.02, 0.05):
@@ -72,8 +74,7 @@ def run(frames: int = 30) -> list[dict[str, Any]]:
                 }
             )
     # OctoMap from the same 320x240 frames (every 4th pixel per direction, 5 cm leaves).
-    cam = DepthCamera()
-    depths = [cam.render(scene, T) for T in poses]
+    cam, depths = frames["320x240"]
     pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
     tree = dp.OccupancyOctree()
     insert_ms = []

@@ -227,10 +227,8 @@ void bindTsdf(py::module& m) {
           "millimetres (0 invalid), T_map_camera a 4 x 4 pose of the optical frame.")
       .def(
           "integrate_points",
-          [](Tsdf& self, const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& points,
-             const Eigen::Vector3d& origin) {
-            std::vector<Eigen::Vector3d> p(points.rows());
-            for (Eigen::Index i = 0; i < points.rows(); ++i) p[i] = points.row(i).transpose();
+          [](Tsdf& self, const PointsRows& points, const Eigen::Vector3d& origin) {
+            const std::vector<Eigen::Vector3d> p = toPoints(points);
             py::gil_scoped_release release;
             return integratePoints(&self.map, p, origin);
           },
@@ -238,8 +236,7 @@ void bindTsdf(py::module& m) {
           "Fuses points (N, 3) in the map frame seen from origin (3,).")
       .def(
           "sample",
-          [](const Tsdf& self,
-             const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& points) {
+          [](const Tsdf& self, const PointsRows& points) {
             const auto n = static_cast<py::ssize_t>(points.rows());
             py::array_t<double> distance(n), weight(n);
             const double mu = self.map.config().truncation();

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <sstream>
+#include <utility>
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tsdf/occupancy_octree.h"
@@ -35,10 +37,30 @@ Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
   return T;
 }
 
+/// Fills a SaveMap reply: the extension check, the writer's outcome (error or "" and what was
+/// written) and one log line.
+void replyToSave(const char* service, const std::string& path, const std::string& extension,
+                 SaveMap::Response& response,
+                 const std::function<std::pair<std::string, std::string>()>& write) {
+  if (path.size() <= extension.size() ||
+      path.compare(path.size() - extension.size(), extension.size(), extension) != 0) {
+    response.success = false;
+    response.message = "only " + extension + " is supported, got '" + path + "'";
+  } else {
+    const auto [why, written] = write();
+    response.success = why.empty();
+    response.message = why.empty() ? "wrote " + written + " to " + path : why;
+  }
+  if (response.success) {
+    ROS_INFO("tsdf: %s", response.message.c_str());
+  } else {
+    ROS_ERROR("tsdf: %s failed: %s", service, response.message.c_str());
+  }
+}
+
 }  // namespace
 
-bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
-                        std::string* why) {
+bool checkDepthImage(const sensor_msgs::Image& image, std::string* why) {
   namespace enc = sensor_msgs::image_encodings;
   const bool is_float = image.encoding == enc::TYPE_32FC1;
   const bool is_mm = image.encoding == enc::TYPE_16UC1 || image.encoding == enc::MONO16;
@@ -58,14 +80,21 @@ bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* met
            std::to_string(image.data.size()) + " bytes)";
     return false;
   }
+  return true;
+}
+
+bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
+                        std::string* why) {
+  if (!checkDepthImage(image, why)) return false;
+  const bool is_float = image.encoding == sensor_msgs::image_encodings::TYPE_32FC1;
   metres->resize(static_cast<std::size_t>(image.width) * image.height);
+  std::vector<std::uint16_t> mm(is_float ? 0 : image.width);  // one row, aligned
   for (std::uint32_t v = 0; v < image.height; ++v) {
     const std::uint8_t* row = image.data.data() + static_cast<std::size_t>(v) * image.step;
     float* out = metres->data() + static_cast<std::size_t>(v) * image.width;
     if (is_float) {
       std::memcpy(out, row, image.width * sizeof(float));
     } else {
-      std::vector<std::uint16_t> mm(image.width);
       std::memcpy(mm.data(), row, image.width * sizeof(std::uint16_t));
       millimetresToMetres(mm.data(), mm.size(), out);
     }
@@ -232,10 +261,9 @@ void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
     reject("bad message: zero stamp", "depth images must carry their measurement time");
     return;
   }
-  std::vector<float> metres;
   std::string why;
   PinholeCamera camera;
-  if (!depthImageToMetres(*msg, &metres, &why)) {
+  if (!checkDepthImage(*msg, &why)) {  // converted once, after tf, in onDepth()
     reject("bad depth image", why);
   } else if (!cameraFor(*msg, &camera, &why)) {
     reject("camera_info missing or inconsistent", why);
@@ -387,21 +415,10 @@ sensor_msgs::PointCloud2Ptr TsdfRos::occupiedCloud(const std_msgs::Header& heade
 
 bool TsdfRos::saveOctomap(SaveMap::Request& request, SaveMap::Response& response) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (request.path.size() < 4 || request.path.substr(request.path.size() - 3) != ".bt") {
-    response.success = false;
-    response.message = "only .bt is supported, got '" + request.path + "'";
-  } else {
+  replyToSave("save_octomap", request.path, ".bt", response, [&] {
     const std::string why = octree_->writeBinary(request.path);
-    response.success = why.empty();
-    response.message =
-        why.empty() ? "wrote " + std::to_string(octree_->leafCount()) + " leaves to " + request.path
-                    : why;
-  }
-  if (response.success) {
-    ROS_INFO("tsdf: %s", response.message.c_str());
-  } else {
-    ROS_ERROR("tsdf: save_octomap failed: %s", response.message.c_str());
-  }
+    return std::make_pair(why, std::to_string(octree_->leafCount()) + " leaves");
+  });
   return true;
 }
 
@@ -428,28 +445,19 @@ nav_msgs::OccupancyGridPtr TsdfRos::makeSlice(const std_msgs::Header& header) {
 }
 
 bool TsdfRos::saveMesh(SaveMap::Request& request, SaveMap::Response& response) {
-  TriangleMesh mesh;
+  // A mesher of its own: the published one's lastUpdated() feeds the markers and must not be
+  // consumed here.
+  TsdfMesher mesher;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    mesher_.update(*map_);
-    mesh = mesher_.combined();
+    mesher.update(*map_);
   }
-  if (request.path.size() < 5 || request.path.substr(request.path.size() - 4) != ".ply") {
-    response.success = false;
-    response.message = "only .ply is supported, got '" + request.path + "'";
-  } else {
-    const std::string why = mesh.writePly(request.path);
-    response.success = why.empty();
-    response.message = why.empty() ? "wrote " + std::to_string(mesh.vertices.size()) +
-                                         " vertices, " + std::to_string(mesh.triangleCount()) +
-                                         " triangles to " + request.path
-                                   : why;
-  }
-  if (response.success) {
-    ROS_INFO("tsdf: %s", response.message.c_str());
-  } else {
-    ROS_ERROR("tsdf: save_mesh failed: %s", response.message.c_str());
-  }
+  const TriangleMesh mesh = mesher.combined();
+  replyToSave("save_mesh", request.path, ".ply", response, [&] {
+    return std::make_pair(mesh.writePly(request.path),
+                          std::to_string(mesh.vertices.size()) + " vertices, " +
+                              std::to_string(mesh.triangleCount()) + " triangles");
+  });
   return true;
 }
 

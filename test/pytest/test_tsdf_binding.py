@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -86,11 +87,14 @@ def test_bad_input_is_refused_with_a_reason() -> None:
     assert tsdf.block_count == 0
 
 
-def room_frames(cam: DepthCamera) -> tuple:
+@functools.cache
+def room_frames(image: str) -> tuple:
+    """The room's 30 frames for "qvga" or "vga", rendered once per test session."""
+    cam = DepthCamera.vga() if image == "vga" else DepthCamera()
     scene = room_scene()
     poses = circle_poses(30)
     depths = [cam.render(scene, T) for T in poses]
-    return scene, poses, depths, observed_samples(scene, cam, poses, depths)
+    return cam, scene, poses, depths, observed_samples(scene, cam, poses, depths)
 
 
 # (image, voxel) -> (mean error m, completeness, ghost fraction) bars. Measured on this room
@@ -107,8 +111,7 @@ BARS = {
 
 @pytest.mark.parametrize(("image", "voxel"), list(BARS))
 def test_room_mesh_accuracy(image: str, voxel: float, tmp_path: Path) -> None:
-    cam = DepthCamera.vga() if image == "vga" else DepthCamera()
-    scene, poses, depths, observed = room_frames(cam)
+    cam, scene, poses, depths, observed = room_frames(image)
     config = dp.TsdfConfig()
     config.voxel_size_m = voxel
     tsdf = dp.Tsdf(config)
@@ -140,8 +143,7 @@ def test_room_mesh_accuracy(image: str, voxel: float, tmp_path: Path) -> None:
 def test_edge_guard_removes_ghosts() -> None:
     # Without the edge guard, rays grazing the box and table rims write "inside" values into the
     # free space beyond their edges: several times more ghost vertices.
-    cam = DepthCamera()
-    scene, poses, depths, observed = room_frames(cam)
+    cam, scene, poses, depths, observed = room_frames("qvga")
     ghosts = {}
     for guard in (0.0, 0.0075):
         config = dp.TsdfConfig()
@@ -177,8 +179,7 @@ def test_slice_puts_the_table_top_into_the_grid() -> None:
     # The room's objects in the 0.05-1.8 m band become obstacles in a 5 cm grid, including the
     # table top (0.72-0.76 m, floating: a 2-D lidar under it would see nothing) and the sphere
     # (0.9-1.5 m); the open floor is free; outside the room is unknown.
-    cam = DepthCamera()
-    scene, poses, depths, _ = room_frames(cam)
+    cam, scene, poses, depths, _ = room_frames("qvga")
     config = dp.TsdfConfig()
     config.voxel_size_m = 0.05
     tsdf = dp.Tsdf(config)
@@ -227,8 +228,7 @@ def test_graceful_under_depth_and_pose_noise() -> None:
     # (Open3D legacy on the anchors' scene: 5.6 mm, 1.34 %, 0.988). The health check sees it.
     from downstream_perception.sim.depth_camera import perturb_pose
 
-    cam = DepthCamera()
-    scene, poses, clean, observed = room_frames(cam)
+    cam, scene, poses, clean, observed = room_frames("qvga")
     depth_rng, pose_rng = np.random.default_rng(0), np.random.default_rng(1)
     tsdf = dp.Tsdf()
     for pose in poses:
