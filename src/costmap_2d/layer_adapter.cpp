@@ -8,6 +8,7 @@
 
 #include "downstream_perception/layers/inflation_layer.h"
 #include "downstream_perception/layers/log_odds_obstacle_layer.h"
+#include "downstream_perception/layers/tsdf_layer.h"
 
 namespace downstream_perception {
 
@@ -168,7 +169,14 @@ class Costmap2dInflationLayer : public Costmap2dLayerAdapter {
   Costmap2dInflationLayer() : Costmap2dLayerAdapter(std::make_shared<InflationLayer>()) {}
 };
 
+/// downstream_perception::TsdfLayer (the TSDF nodelet's slice) for costmap_2d / move_base.
+class Costmap2dTsdfLayer : public Costmap2dLayerAdapter {
+ public:
+  Costmap2dTsdfLayer() : Costmap2dLayerAdapter(std::make_shared<TsdfLayer>()) {}
+};
+
 }  // namespace downstream_perception
 
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dLogOddsObstacleLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dInflationLayer, costmap_2d::Layer)
+PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dTsdfLayer, costmap_2d::Layer)

@@ -60,7 +60,9 @@ try:
         OccupancyOctree,
         OctreeConfig,
         PinholeCamera,
+        PlanarTrack,
         Pose2D,
+        PredictionConfig,
         ScanIntegrator,
         ScanIntegratorConfig,
         Tracker,
@@ -87,10 +89,13 @@ try:
         nms,
         normalize_angle,
         occupancy_table,
+        predicted_cells,
         probability_of,
         ray_cells,
         shortest_angular_distance,
         solve_assignment,
+        swept_polygon,
+        uncertainty_radius,
     )
 
     _CORE_IMPORT_ERROR: ImportError | None = None

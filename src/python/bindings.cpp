@@ -20,6 +20,7 @@
 #include "downstream_perception/core/tracking/assignment.h"
 #include "downstream_perception/core/tracking/box.h"
 #include "downstream_perception/core/tracking/kalman.h"
+#include "downstream_perception/core/tracking/predicted_footprint.h"
 #include "downstream_perception/core/tracking/tracker.h"
 
 namespace py = pybind11;
@@ -478,6 +479,73 @@ PYBIND11_MODULE(_core, m) {
         return maskIou(a.data(), b.data(), static_cast<std::size_t>(a.size()));
       },
       py::arg("a"), py::arg("b"), "IoU of two binary masks (non-zero = foreground).");
+  // ----------------------------------------------------------------- predicted obstacles
+  py::class_<PredictionConfig>(m, "PredictionConfig")
+      .def(py::init<>())
+      .def_readwrite("prediction_horizon_s", &PredictionConfig::prediction_horizon_s, "s")
+      .def_readwrite("uncertainty_sigmas", &PredictionConfig::uncertainty_sigmas)
+      .def_readwrite("max_uncertainty_m", &PredictionConfig::max_uncertainty_m, "m")
+      .def_readwrite("min_object_size_m", &PredictionConfig::min_object_size_m, "m")
+      .def_readwrite("max_object_size_m", &PredictionConfig::max_object_size_m, "m")
+      .def_readwrite("max_speed_mps", &PredictionConfig::max_speed_mps, "m/s")
+      .def("validate", &PredictionConfig::validate);
+  py::class_<PlanarTrack>(m, "PlanarTrack", "One track in the costmap's frame.")
+      .def(py::init([](const Eigen::Vector2d& position, const Eigen::Vector2d& velocity,
+                       const Eigen::Matrix2d& position_covariance,
+                       const Eigen::Matrix2d& velocity_covariance, double size_x, double size_y,
+                       double box_yaw) {
+             PlanarTrack t;
+             t.position = position;
+             t.velocity = velocity;
+             t.position_covariance = position_covariance;
+             t.velocity_covariance = velocity_covariance;
+             t.size_x = size_x;
+             t.size_y = size_y;
+             t.box_yaw = box_yaw;
+             return t;
+           }),
+           py::arg("position"), py::arg("velocity"),
+           py::arg("position_covariance") = Eigen::Matrix2d::Zero().eval(),
+           py::arg("velocity_covariance") = Eigen::Matrix2d::Zero().eval(),
+           py::arg("size_x") = 0.0, py::arg("size_y") = 0.0, py::arg("box_yaw") = 0.0)
+      .def_readwrite("position", &PlanarTrack::position, "m")
+      .def_readwrite("velocity", &PlanarTrack::velocity, "m/s")
+      .def_readwrite("position_covariance", &PlanarTrack::position_covariance, "m^2")
+      .def_readwrite("velocity_covariance", &PlanarTrack::velocity_covariance, "m^2/s^2")
+      .def_readwrite("size_x", &PlanarTrack::size_x, "m")
+      .def_readwrite("size_y", &PlanarTrack::size_y, "m")
+      .def_readwrite("box_yaw", &PlanarTrack::box_yaw, "rad")
+      .def("validate", &PlanarTrack::validate);
+  m.def("uncertainty_radius", &uncertaintyRadius, py::arg("track"), py::arg("dt_s"),
+        py::arg("config"), "k sigma of the predicted position dt_s after the stamp, m (capped).");
+  m.def(
+      "swept_polygon",
+      [](const PlanarTrack& track, double duration_s, const PredictionConfig& config) {
+        const Footprint polygon = sweptPolygon(track, duration_s, config);
+        py::array_t<double> out({static_cast<py::ssize_t>(polygon.size()), py::ssize_t{2}});
+        auto a = out.mutable_unchecked<2>();
+        for (py::ssize_t i = 0; i < static_cast<py::ssize_t>(polygon.size()); ++i) {
+          a(i, 0) = polygon[i].x;
+          a(i, 1) = polygon[i].y;
+        }
+        return out;
+      },
+      py::arg("track"), py::arg("duration_s"), py::arg("config"),
+      "Convex polygon (N x 2, counter-clockwise) the box sweeps over duration_s.");
+  m.def(
+      "predicted_cells",
+      [](const PlanarTrack& track, double age_s, const PredictionConfig& config,
+         const GridGeometry& geometry) {
+        std::vector<std::size_t> cells;
+        predictedCells(track, age_s, config, geometry, &cells);
+        std::vector<CellIndex> xy;
+        xy.reserve(cells.size());
+        for (const std::size_t i : cells) xy.push_back(geometry.cellOf(i));
+        return cellsToArray(xy);
+      },
+      py::arg("track"), py::arg("age_s"), py::arg("config"), py::arg("geometry"),
+      "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s.");
+
   m.def("chi_square_quantile", &chiSquareQuantile, py::arg("dof"), py::arg("confidence"),
         "Squared-Mahalanobis gate: chi-square quantile (2, 0.99) -> 9.21.");
   m.def(

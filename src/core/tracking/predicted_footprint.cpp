@@ -1,0 +1,177 @@
+#include "downstream_perception/core/tracking/predicted_footprint.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "downstream_perception/core/ray_traversal.h"
+
+namespace downstream_perception {
+
+std::string PredictionConfig::validate() const {
+  std::ostringstream why;
+  const auto bad = [](double v, double lo) { return !(std::isfinite(v) && v >= lo); };
+  if (bad(prediction_horizon_s, 0.0) || prediction_horizon_s > 60.0) {
+    why << "prediction_horizon_s must be in [0, 60] s, got " << prediction_horizon_s;
+  } else if (bad(uncertainty_sigmas, 0.0) || uncertainty_sigmas > 10.0) {
+    why << "uncertainty_sigmas must be in [0, 10], got " << uncertainty_sigmas;
+  } else if (bad(max_uncertainty_m, 0.0)) {
+    why << "max_uncertainty_m must be finite and >= 0 m, got " << max_uncertainty_m;
+  } else if (bad(min_object_size_m, 0.0) || bad(max_object_size_m, min_object_size_m)) {
+    why << "object sizes must satisfy 0 <= min_object_size_m <= max_object_size_m, got "
+        << min_object_size_m << " and " << max_object_size_m;
+  } else if (bad(max_speed_mps, 0.0)) {
+    why << "max_speed_mps must be finite and >= 0 m/s, got " << max_speed_mps;
+  }
+  return why.str();
+}
+
+std::string PlanarTrack::validate() const {
+  if (!position.allFinite()) return "position is not finite";
+  if (!velocity.allFinite()) return "velocity is not finite";
+  if (!position_covariance.allFinite() || !velocity_covariance.allFinite()) {
+    return "covariance is not finite";
+  }
+  if (!std::isfinite(size_x) || !std::isfinite(size_y) || !std::isfinite(box_yaw)) {
+    return "size or orientation is not finite";
+  }
+  if (size_x < 0.0 || size_y < 0.0) return "negative size";
+  const auto asymmetric = [](const Eigen::Matrix2d& m) {
+    return std::abs(m(0, 1) - m(1, 0)) > 1e-9 * (1.0 + m.cwiseAbs().maxCoeff());
+  };
+  if (asymmetric(position_covariance) || asymmetric(velocity_covariance)) {
+    return "covariance is not symmetric";
+  }
+  return {};
+}
+
+Eigen::Vector2d predictPosition(const PlanarTrack& track, double dt_s) {
+  return track.position + track.velocity * dt_s;
+}
+
+double uncertaintyRadius(const PlanarTrack& track, double dt_s, const PredictionConfig& config) {
+  if (config.uncertainty_sigmas <= 0.0) return 0.0;
+  const Eigen::Matrix2d sigma =
+      track.position_covariance + dt_s * dt_s * track.velocity_covariance;
+  // Largest eigenvalue of a symmetric 2 x 2, in closed form.
+  const double mean = 0.5 * (sigma(0, 0) + sigma(1, 1));
+  const double half_gap = 0.5 * (sigma(0, 0) - sigma(1, 1));
+  const double largest = std::max(0.0, mean + std::hypot(half_gap, sigma(0, 1)));
+  return std::min(config.max_uncertainty_m, config.uncertainty_sigmas * std::sqrt(largest));
+}
+
+namespace {
+
+double cross(const FootprintPoint& o, const FootprintPoint& a, const FootprintPoint& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+/// Andrew's monotone chain: the convex hull, counter-clockwise, collinear points dropped.
+Footprint convexHull(Footprint points) {
+  std::sort(points.begin(), points.end(), [](const FootprintPoint& a, const FootprintPoint& b) {
+    return a.x < b.x || (a.x == b.x && a.y < b.y);
+  });
+  if (points.size() < 3) return points;
+  Footprint hull(2 * points.size());
+  std::size_t k = 0;
+  for (const FootprintPoint& p : points) {  // lower chain
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0.0) --k;
+    hull[k++] = p;
+  }
+  const std::size_t lower = k + 1;
+  for (auto it = points.rbegin() + 1; it != points.rend(); ++it) {  // upper chain
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], *it) <= 0.0) --k;
+    hull[k++] = *it;
+  }
+  hull.resize(k - 1);  // the last point repeats the first
+  return hull;
+}
+
+double segmentDistance(double px, double py, const FootprintPoint& a, const FootprintPoint& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double len2 = dx * dx + dy * dy;
+  double t = len2 > 0.0 ? ((px - a.x) * dx + (py - a.y) * dy) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(px - (a.x + t * dx), py - (a.y + t * dy));
+}
+
+/// Distance from a point to a convex counter-clockwise polygon (0 inside); a polygon of one or
+/// two vertices is a point or a segment.
+double convexDistance(double px, double py, const Footprint& hull) {
+  if (hull.size() == 1) return std::hypot(px - hull[0].x, py - hull[0].y);
+  if (hull.size() == 2) return segmentDistance(px, py, hull[0], hull[1]);
+  bool inside = true;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const FootprintPoint& a = hull[i];
+    const FootprintPoint& b = hull[(i + 1) % hull.size()];
+    if (cross(a, b, {px, py}) < 0.0) inside = false;
+    nearest = std::min(nearest, segmentDistance(px, py, a, b));
+  }
+  return inside ? 0.0 : nearest;
+}
+
+}  // namespace
+
+Footprint sweptPolygon(const PlanarTrack& track, double duration_s,
+                       const PredictionConfig& config) {
+  const double hx =
+      0.5 * std::clamp(track.size_x, config.min_object_size_m, config.max_object_size_m);
+  const double hy =
+      0.5 * std::clamp(track.size_y, config.min_object_size_m, config.max_object_size_m);
+  const double c = std::cos(track.box_yaw), s = std::sin(track.box_yaw);
+  Footprint corners;
+  for (const Eigen::Vector2d& centre :
+       {predictPosition(track, 0.0), predictPosition(track, duration_s)}) {
+    for (const double sx : {-hx, hx}) {
+      for (const double sy : {-hy, hy}) {
+        corners.push_back({centre.x() + c * sx - s * sy, centre.y() + s * sx + c * sy});
+      }
+    }
+  }
+  return convexHull(std::move(corners));
+}
+
+CellBounds predictedCells(const PlanarTrack& track, double age_s, const PredictionConfig& config,
+                          const GridGeometry& geometry, std::vector<std::size_t>* cells) {
+  CellBounds bounds;
+  if (!track.validate().empty() || !(std::isfinite(age_s) && age_s >= 0.0)) return bounds;
+  if (track.velocity.norm() > config.max_speed_mps) return bounds;
+  const double duration = age_s + config.prediction_horizon_s;
+  const Footprint hull = sweptPolygon(track, duration, config);
+  const double grow = uncertaintyRadius(track, duration, config);
+  const std::size_t first = cells->size();
+
+  // Cells whose centre lies within `grow` of the hull, over the hull's bounding box.
+  double min_x = hull[0].x, max_x = hull[0].x, min_y = hull[0].y, max_y = hull[0].y;
+  for (const FootprintPoint& p : hull) {
+    min_x = std::min(min_x, p.x), max_x = std::max(max_x, p.x);
+    min_y = std::min(min_y, p.y), max_y = std::max(max_y, p.y);
+  }
+  const CellBounds box =
+      geometry.worldBoxToCells(min_x - grow, min_y - grow, max_x + grow, max_y + grow);
+  for (int cy = box.min_y; cy <= box.max_y; ++cy) {
+    for (int cx = box.min_x; cx <= box.max_x; ++cx) {
+      double wx = 0.0, wy = 0.0;
+      geometry.cellCentre(cx, cy, &wx, &wy);
+      if (convexDistance(wx, wy, hull) <= grow) cells->push_back(geometry.index(cx, cy));
+    }
+  }
+  // Every cell the centre path crosses (Amanatides-Woo, both ends included).
+  const Eigen::Vector2d a = predictPosition(track, 0.0), b = predictPosition(track, duration);
+  double x0 = a.x(), y0 = a.y(), x1 = b.x(), y1 = b.y();
+  if (clipSegmentToGrid(geometry, &x0, &y0, &x1, &y1)) {
+    traverseRay(geometry, x0, y0, x1, y1, true,
+                [&](int cx, int cy) { cells->push_back(geometry.index(cx, cy)); });
+  }
+  std::sort(cells->begin() + first, cells->end());
+  cells->erase(std::unique(cells->begin() + first, cells->end()), cells->end());
+  for (std::size_t i = first; i < cells->size(); ++i) {
+    const CellIndex cell = geometry.cellOf((*cells)[i]);
+    bounds.expand(cell.x, cell.y);
+  }
+  return bounds;
+}
+
+}  // namespace downstream_perception

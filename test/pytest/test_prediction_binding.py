@@ -1,0 +1,93 @@
+"""pytest: predicted track footprints through the bindings: the lesson's forklift corridor, and
+the swept shape against an independent numpy rasterisation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import downstream_perception as dp
+
+
+def point_config() -> dp.PredictionConfig:
+    config = dp.PredictionConfig()
+    config.prediction_horizon_s = 1.5
+    config.uncertainty_sigmas = 0.0
+    return config
+
+
+def test_lesson_forklift_corridor() -> None:
+    grid = dp.GridGeometry(400, 200, 0.05, 0.0, 0.0)
+    forklift = dp.PlanarTrack([8.0186, 4.0921], [-0.6, 0.0])
+    cells = dp.predicted_cells(forklift, 0.0, point_config(), grid)
+    assert sorted(map(tuple, cells.tolist())) == [(x, 81) for x in range(142, 161)]
+    costs = np.zeros((200, 400), dtype=np.uint8)
+    costs[cells[:, 1], cells[:, 0]] = dp.LETHAL_OBSTACLE
+    inflation = dp.InflationConfig()
+    inflation.inflation_radius = 0.40
+    inflation.inscribed_radius = 0.20
+    inflation.cost_scaling_factor = 3.0
+    inflated = dp.inflate(costs, 0.05, inflation)
+    columns = np.flatnonzero(inflated[81])
+    assert (columns[0], columns[-1]) == (134, 168)
+    assert (columns[-1] - columns[0]) * 0.05 == pytest.approx(1.70)  # the 34-cell corridor
+
+
+def rasterise(polygon: np.ndarray, grow: float, grid: dp.GridGeometry) -> set[tuple[int, int]]:
+    """Cells whose centre is within `grow` of a convex CCW polygon, by brute force in numpy."""
+    xs = grid.origin_x + (np.arange(grid.size_x) + 0.5) * grid.resolution
+    ys = grid.origin_y + (np.arange(grid.size_y) + 0.5) * grid.resolution
+    px, py = np.meshgrid(xs, ys)
+    a = polygon
+    b = np.roll(polygon, -1, axis=0)
+    inside = np.ones_like(px, dtype=bool)
+    nearest = np.full_like(px, np.inf)
+    for (ax, ay), (bx, by) in zip(a, b, strict=True):
+        inside &= (bx - ax) * (py - ay) - (by - ay) * (px - ax) >= 0
+        dx, dy = bx - ax, by - ay
+        t = np.clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0, 1)
+        nearest = np.minimum(nearest, np.hypot(px - ax - t * dx, py - ay - t * dy))
+    covered = inside | (nearest <= grow)
+    yy, xx = np.nonzero(covered)
+    return set(zip(xx.tolist(), yy.tolist(), strict=True))
+
+
+def test_swept_box_with_uncertainty_matches_numpy() -> None:
+    grid = dp.GridGeometry(160, 160, 0.05, 0.0, 0.0)
+    config = dp.PredictionConfig()
+    config.prediction_horizon_s = 1.0
+    config.uncertainty_sigmas = 2.0
+    track = dp.PlanarTrack(
+        [2.0, 3.0],
+        [1.2, 0.9],
+        np.diag([0.004, 0.002]),
+        np.diag([0.01, 0.01]),
+        size_x=0.8,
+        size_y=0.5,
+        box_yaw=math.radians(30),
+    )
+    age = 0.25
+    polygon = dp.swept_polygon(track, age + 1.0, config)
+    assert polygon.shape == (6, 2)  # a box moving off its axes sweeps a hexagon
+    grow = dp.uncertainty_radius(track, age + 1.0, config)
+    sigma = np.diag([0.004, 0.002]) + (age + 1.0) ** 2 * np.diag([0.01, 0.01])
+    assert grow == pytest.approx(2.0 * math.sqrt(np.linalg.eigvalsh(sigma).max()))
+    expected = rasterise(polygon, grow, grid)
+    got = set(map(tuple, dp.predicted_cells(track, age, config, grid).tolist()))
+    # The centre path's cells are inside the swept box anyway: the sets agree exactly.
+    assert got == expected
+    assert len(got) > 100
+
+
+def test_bad_tracks_give_no_cells() -> None:
+    grid = dp.GridGeometry(100, 100, 0.05, 0.0, 0.0)
+    config = dp.PredictionConfig()
+    nan_track = dp.PlanarTrack([math.nan, 1.0], [0.0, 0.0])
+    assert nan_track.validate() != ""
+    assert dp.predicted_cells(nan_track, 0.0, config, grid).shape == (0, 2)
+    fast = dp.PlanarTrack([1.0, 1.0], [100.0, 0.0])  # beyond max_speed_mps
+    assert dp.predicted_cells(fast, 0.0, config, grid).shape == (0, 2)
+    config.prediction_horizon_s = -1.0
+    assert "prediction_horizon_s" in config.validate()
