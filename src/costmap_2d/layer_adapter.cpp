@@ -8,6 +8,7 @@
 
 #include "downstream_perception/layers/inflation_layer.h"
 #include "downstream_perception/layers/log_odds_obstacle_layer.h"
+#include "downstream_perception/layers/tracked_obstacle_layer.h"
 #include "downstream_perception/layers/tsdf_layer.h"
 
 namespace downstream_perception {
@@ -175,8 +176,16 @@ class Costmap2dTsdfLayer : public Costmap2dLayerAdapter {
   Costmap2dTsdfLayer() : Costmap2dLayerAdapter(std::make_shared<TsdfLayer>()) {}
 };
 
+/// downstream_perception::TrackedObstacleLayer for costmap_2d / move_base.
+class Costmap2dTrackedObstacleLayer : public Costmap2dLayerAdapter {
+ public:
+  Costmap2dTrackedObstacleLayer()
+      : Costmap2dLayerAdapter(std::make_shared<TrackedObstacleLayer>()) {}
+};
+
 }  // namespace downstream_perception
 
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dLogOddsObstacleLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dInflationLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dTsdfLayer, costmap_2d::Layer)
+PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dTrackedObstacleLayer, costmap_2d::Layer)
