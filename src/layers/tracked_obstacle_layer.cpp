@@ -1,7 +1,7 @@
 #include "downstream_perception/layers/tracked_obstacle_layer.h"
 
-#include <pluginlib/class_list_macros.hpp>
 #include <tf2/utils.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <Eigen/Geometry>
 
@@ -70,8 +70,8 @@ void TrackedObstacleLayer::subscribe() {
       [this](const TrackedObjectArrayConstPtr& msg,
              tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
         std::ostringstream detail;
-        detail << "frame '" << msg->header.frame_id << "' -> '"
-               << layered_costmap_->globalFrame() << "' at stamp " << msg->header.stamp;
+        detail << "frame '" << msg->header.frame_id << "' -> '" << layered_costmap_->globalFrame()
+               << "' at stamp " << msg->header.stamp;
         reject(tfFailureReason(reason), detail.str());
       });
 }
@@ -97,8 +97,8 @@ void TrackedObstacleLayer::onTracks(const TrackedObjectArrayConstPtr& msg) {
   }
   const auto& q = transform.transform.rotation;
   const auto& v = transform.transform.translation;
-  const Eigen::Isometry3d T = Eigen::Translation3d(v.x, v.y, v.z) *
-                              Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+  const Eigen::Isometry3d T =
+      Eigen::Translation3d(v.x, v.y, v.z) * Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
   // Tracks live in the plane: velocities and covariances rotate by the transform's yaw.
   const double yaw = tf2::getYaw(transform.transform.rotation);
   const Eigen::Matrix2d R = Eigen::Rotation2Dd(yaw).toRotationMatrix();
@@ -145,8 +145,7 @@ void TrackedObstacleLayer::updateBounds(double, double, double, double* min_x, d
                                         double* max_x, double* max_y) {
   std::lock_guard<std::mutex> lock(mutex_);
   const ros::Time now = ros::Time::now();
-  const bool fresh =
-      !tracks_stamp_.isZero() && (now - tracks_stamp_).toSec() <= track_timeout_s_;
+  const bool fresh = !tracks_stamp_.isZero() && (now - tracks_stamp_).toSec() <= track_timeout_s_;
   current_ = fresh;
   if (!fresh && !tracks_.empty()) {
     tracks_.clear();  // a stale track never stays in the map

@@ -506,8 +506,8 @@ PYBIND11_MODULE(_core, m) {
            }),
            py::arg("position"), py::arg("velocity"),
            py::arg("position_covariance") = Eigen::Matrix2d::Zero().eval(),
-           py::arg("velocity_covariance") = Eigen::Matrix2d::Zero().eval(),
-           py::arg("size_x") = 0.0, py::arg("size_y") = 0.0, py::arg("box_yaw") = 0.0)
+           py::arg("velocity_covariance") = Eigen::Matrix2d::Zero().eval(), py::arg("size_x") = 0.0,
+           py::arg("size_y") = 0.0, py::arg("box_yaw") = 0.0)
       .def_readwrite("position", &PlanarTrack::position, "m")
       .def_readwrite("velocity", &PlanarTrack::velocity, "m/s")
       .def_readwrite("position_covariance", &PlanarTrack::position_covariance, "m^2")

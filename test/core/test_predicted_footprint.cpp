@@ -5,8 +5,8 @@
 #include <limits>
 #include <set>
 
-#include "downstream_perception/core/costmap.h"
 #include "downstream_perception/core/cost_values.h"
+#include "downstream_perception/core/costmap.h"
 #include "downstream_perception/core/inflation.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
 
@@ -59,7 +59,8 @@ TEST(PredictedFootprint, LessonCorridorIsInflatedTo34CellsWide) {
   std::vector<std::size_t> cells;
   predictedCells(forklift(), 0.0, pointPrediction(), g, &cells);
   Costmap map(g, cost::kFreeSpace);
-  for (const std::size_t i : cells) map.setCost(g.cellOf(i).x, g.cellOf(i).y, cost::kLethalObstacle);
+  for (const std::size_t i : cells)
+    map.setCost(g.cellOf(i).x, g.cellOf(i).y, cost::kLethalObstacle);
   InflationConfig c;
   c.inflation_radius = 0.40;
   c.inscribed_radius = 0.20;

@@ -52,8 +52,7 @@ Eigen::Vector2d predictPosition(const PlanarTrack& track, double dt_s) {
 
 double uncertaintyRadius(const PlanarTrack& track, double dt_s, const PredictionConfig& config) {
   if (config.uncertainty_sigmas <= 0.0) return 0.0;
-  const Eigen::Matrix2d sigma =
-      track.position_covariance + dt_s * dt_s * track.velocity_covariance;
+  const Eigen::Matrix2d sigma = track.position_covariance + dt_s * dt_s * track.velocity_covariance;
   // Largest eigenvalue of a symmetric 2 x 2, in closed form.
   const double mean = 0.5 * (sigma(0, 0) + sigma(1, 1));
   const double half_gap = 0.5 * (sigma(0, 0) - sigma(1, 1));

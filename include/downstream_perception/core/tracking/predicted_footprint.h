@@ -36,12 +36,12 @@ struct PredictionConfig {
 
 /// One track in the costmap's frame.
 struct PlanarTrack {
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< m, at the measurement stamp
-  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();             ///< m, at the measurement stamp
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();             ///< m/s
   Eigen::Matrix2d position_covariance = Eigen::Matrix2d::Zero();  ///< m²
   Eigen::Matrix2d velocity_covariance = Eigen::Matrix2d::Zero();  ///< m²/s²
-  double size_x = 0.0;  ///< m, box side along the box's x axis
-  double size_y = 0.0;  ///< m
+  double size_x = 0.0;   ///< m, box side along the box's x axis
+  double size_y = 0.0;   ///< m
   double box_yaw = 0.0;  ///< rad: the box's x axis in the costmap frame
 
   /// Empty if every field is finite and the covariances are symmetric, else the reason.
