@@ -1,0 +1,79 @@
+// Health of the perception-to-planning seam, ROS-free: how old the transforms that place each
+// input are, how far that age throws an obstacle when the robot turns, and whether the
+// localisation correction map <- odom behaves (it should sawtooth: ramp up as odometry drifts,
+// snap back at each correction).
+#pragma once
+
+#include <cstddef>
+#include <deque>
+#include <string>
+#include <vector>
+
+namespace downstream_perception {
+
+/// Sideways throw (m) of an obstacle at range_m placed with a transform age_s old while the robot
+/// yaws at yaw_rate_rps: range * tan(|yaw_rate| * age) (the lesson's 5 m * tan(90 deg/s * 30 ms)
+/// = 0.236 m).
+double expectedSmear(double range_m, double yaw_rate_rps, double age_s);
+
+/// Percentiles of the last `capacity` samples (transform ages).
+class SampleWindow {
+ public:
+  explicit SampleWindow(std::size_t capacity = 200) : capacity_(capacity) {}
+  void add(double value);
+  /// The q-quantile (q in [0, 1], nearest rank) of the samples held; 0 if none.
+  double percentile(double q) const;
+  std::size_t size() const { return samples_.size(); }
+  std::size_t total() const { return total_; }
+  void clear() { samples_.clear(); }
+
+ private:
+  std::size_t capacity_;
+  std::size_t total_ = 0;
+  std::deque<double> samples_;
+};
+
+struct CorrectionMonitorConfig {
+  double window_s = 120.0;        ///< s of history judged
+  double reset_drop_m = 0.05;     ///< m: a fall of the correction this large is a correction event
+  double max_correction_m = 2.0;  ///< m: warn above (the lesson: 2 m ~ 100 m of 2 % drift)
+  double zero_epsilon_m = 1e-3;   ///< m: a correction this small counts as zero
+  /// m of robot travel within the window after which a correction stuck at zero is suspicious
+  /// (the localiser may be silently rejecting fixes).
+  double min_travel_m = 20.0;
+  /// m the correction must grow within the window without a single reset before it counts as
+  /// "never resets" (loop closures not firing).
+  double ramp_m = 0.5;
+
+  std::string validate() const;
+};
+
+/// Watches |map <- odom| over time.
+class CorrectionMonitor {
+ public:
+  explicit CorrectionMonitor(const CorrectionMonitorConfig& config = {}) : config_(config) {}
+  /// One sample: time (s), the correction's translation magnitude (m) and the robot's travelled
+  /// distance so far (m, from odometry).
+  void add(double time_s, double correction_m, double travelled_m);
+
+  std::size_t resets() const { return resets_; }
+  double latest() const { return samples_.empty() ? 0.0 : samples_.back().correction; }
+  bool tooLarge() const { return latest() > config_.max_correction_m; }
+  /// The correction stayed ~0 over the window while the robot travelled min_travel_m.
+  bool stuckAtZero() const;
+  /// The correction grew by ramp_m over the window without a reset.
+  bool neverResets() const;
+  /// Empty if healthy, else what is wrong (one line per finding).
+  std::vector<std::string> findings() const;
+
+ private:
+  struct Sample {
+    double time, correction, travelled;
+  };
+  CorrectionMonitorConfig config_;
+  std::deque<Sample> samples_;
+  std::deque<double> reset_times_;
+  std::size_t resets_ = 0;
+};
+
+}  // namespace downstream_perception
