@@ -106,9 +106,13 @@ class TrackedObstaclesTest(unittest.TestCase):
             lethal = np.flatnonzero(row == 100)
             inflated = np.flatnonzero(row > 0)
             self.assertGreater(lethal.size, 0, "no lethal cells on row 81")
-            # The forklift's cell now: the corridor's far end (it moves towards -x).
-            x_now = self.x0 + SPEED * t
-            self.assertLessEqual(abs(lethal[-1] - math.floor(x_now / RES)), 3)
+            # The corridor's far end is the forklift's cell at the track's stamp (it moves
+            # towards -x). The grid read here is up to one publish period (0.25 s) plus one
+            # update (0.08 s) old: the end lies between the cells of now and of 0.5 s ago.
+            newest = math.floor((self.x0 + SPEED * t) / RES)
+            oldest = math.floor((self.x0 + SPEED * (t - 0.5)) / RES)
+            self.assertGreaterEqual(lethal[-1], newest - 1)
+            self.assertLessEqual(lethal[-1], oldest + 1)
             # Back along its path by 0.6 m/s x (age + 1.5 s): about 18 cells plus the age.
             self.assertGreaterEqual(lethal.size, round(abs(SPEED) * HORIZON / RES) - 1)
             self.assertLessEqual(lethal.size, round(abs(SPEED) * (HORIZON + 0.5) / RES) + 2)
