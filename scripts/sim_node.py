@@ -18,7 +18,7 @@ from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
 
-from downstream_perception.ros_util import transform_stamped
+from downstream_perception.ros_util import laser_scan, transform_stamped
 from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive
 
 
@@ -128,17 +128,17 @@ class SimNode:
         laser = map_base @ se2_matrix(self.laser_x, 0.0, 0.0)
         pose = (float(laser[0, 2]), float(laser[1, 2]), math.atan2(laser[1, 0], laser[0, 0]))
         c = self.lidar.config
-        msg = LaserScan()
-        msg.header.stamp = stamp
-        msg.header.frame_id = self.frames["laser"]
-        msg.angle_min = c.angle_min
-        msg.angle_increment = c.angle_increment
-        msg.angle_max = c.angle_min + (c.num_beams - 1) * c.angle_increment
-        msg.time_increment = 0.0
+        ranges = self.lidar.scan(self.world, pose, t)
+        msg = laser_scan(
+            stamp,
+            self.frames["laser"],
+            ranges,
+            c.angle_min,
+            c.angle_increment,
+            c.range_min,
+            c.range_max,
+        )
         msg.scan_time = 1.0 / self.scan_rate
-        msg.range_min = c.range_min
-        msg.range_max = c.range_max
-        msg.ranges = self.lidar.scan(self.world, pose, t).tolist()
         self.scan_pub.publish(msg)
 
 

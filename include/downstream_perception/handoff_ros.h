@@ -23,9 +23,11 @@
 #include <string>
 #include <vector>
 
+#include "downstream_perception/SeamHealth.h"
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/TransformPose.h"
 #include "downstream_perception/core/seam_health.h"
+#include "downstream_perception/filtered_subscription.h"
 
 namespace downstream_perception {
 
@@ -34,10 +36,13 @@ class HandoffRos {
   HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh);
 
  private:
+  /// One watched input; its messages are released once they can be placed in planning_frame at
+  /// their stamp (tf2 MessageFilter), so the recorded age is what a consumer experiences.
   struct Input {
     std::string topic;
     std::string type;
-    ros::Subscriber subscriber;
+    FilteredSubscription<sensor_msgs::LaserScan> scans;
+    FilteredSubscription<TrackedObjectArray> tracks;
     SampleWindow ages;
     std::size_t tf_failures = 0;
   };
@@ -45,7 +50,8 @@ class HandoffRos {
   void loadParameters();
   Input& addInput(const std::string& topic, const std::string& type);
   void recordArrival(Input* input, const ros::Time& stamp);
-  void onScan(Input* input, const sensor_msgs::LaserScanConstPtr& msg);
+  void onTfFailure(Input* input, const std::string& frame, const ros::Time& stamp,
+                   tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onTracks(Input* input, const TrackedObjectArrayConstPtr& msg);
   void onGoal(const geometry_msgs::PoseStampedConstPtr& msg);
   bool onTransformPose(TransformPose::Request& req, TransformPose::Response& res);
@@ -75,10 +81,9 @@ class HandoffRos {
   double travelled_m_ = 0.0;
   bool have_last_base_ = false;
   double last_base_x_ = 0.0, last_base_y_ = 0.0;
-  double correction_m_ = 0.0, correction_yaw_ = 0.0, map_odom_age_s_ = -1.0;
+  SeamHealth health_;  ///< the last report, also what diagnostics show
   std::size_t goals_ = 0, goal_failures_ = 0;
   std::string last_goal_failure_;
-  std::vector<std::string> warnings_;
   std::vector<std::string> config_errors_;
 
   ros::Publisher goal_publisher_, tracks_publisher_, health_publisher_;

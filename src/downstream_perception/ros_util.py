@@ -9,6 +9,7 @@ from collections.abc import Callable
 import numpy as np
 import rospy
 from geometry_msgs.msg import TransformStamped
+from sensor_msgs.msg import LaserScan
 
 
 def transform_stamped(
@@ -31,6 +32,28 @@ def transform_stamped(
     t.transform.rotation.z = math.sin(yaw / 2.0)
     t.transform.rotation.w = math.cos(yaw / 2.0)
     return t
+
+
+def laser_scan(
+    stamp: rospy.Time,
+    frame: str,
+    ranges: np.ndarray | list[float],
+    angle_min: float,
+    angle_increment: float,
+    range_min: float,
+    range_max: float,
+) -> LaserScan:
+    """A LaserScan (ranges in m, angles in rad); angle_max follows from the beam count."""
+    msg = LaserScan()
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame
+    msg.angle_min = angle_min
+    msg.angle_increment = angle_increment
+    msg.angle_max = angle_min + (len(ranges) - 1) * angle_increment
+    msg.range_min = range_min
+    msg.range_max = range_max
+    msg.ranges = np.asarray(ranges, dtype=np.float32).tolist()
+    return msg
 
 
 def transform_from_matrix(

@@ -3,16 +3,16 @@
 #include <tf2/utils.h>
 #include <pluginlib/class_list_macros.hpp>
 
-#include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/layered_costmap.h"
 #include "downstream_perception/tf_failure.h"
+#include "downstream_perception/track_transform.h"
 
 namespace downstream_perception {
 
@@ -95,13 +95,7 @@ void TrackedObstacleLayer::onTracks(const TrackedObjectArrayConstPtr& msg) {
     reject("tf: lookup at stamp failed", e.what());
     return;
   }
-  const auto& q = transform.transform.rotation;
-  const auto& v = transform.transform.translation;
-  const Eigen::Isometry3d T =
-      Eigen::Translation3d(v.x, v.y, v.z) * Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
-  // Tracks live in the plane: velocities and covariances rotate by the transform's yaw.
-  const double yaw = tf2::getYaw(transform.transform.rotation);
-  const Eigen::Matrix2d R = Eigen::Rotation2Dd(yaw).toRotationMatrix();
+  const double box_yaw = tf2::getYaw(transform.transform.rotation);
   std::vector<PlanarTrack> tracks;
   std::size_t skipped_state = 0;
   for (const TrackedObject& object : msg->tracks) {
@@ -112,16 +106,15 @@ void TrackedObstacleLayer::onTracks(const TrackedObjectArrayConstPtr& msg) {
       ++skipped_state;
       continue;
     }
+    const TrackedObject placed = transformTrack(object, transform);
     PlanarTrack t;
-    const Eigen::Vector3d p =
-        T * Eigen::Vector3d(object.position.x, object.position.y, object.position.z);
-    t.position = p.head<2>();
-    t.velocity = R * Eigen::Vector2d(object.velocity.x, object.velocity.y);
-    t.position_covariance = R * covariance2(object.position_covariance) * R.transpose();
-    t.velocity_covariance = R * covariance2(object.velocity_covariance) * R.transpose();
+    t.position = {placed.position.x, placed.position.y};
+    t.velocity = {placed.velocity.x, placed.velocity.y};
+    t.position_covariance = covariance2(placed.position_covariance);
+    t.velocity_covariance = covariance2(placed.velocity_covariance);
     t.size_x = object.size_x;
     t.size_y = object.size_y;
-    t.box_yaw = yaw;
+    t.box_yaw = box_yaw;
     const std::string why = t.validate();
     if (!why.empty()) {
       reject("bad track", "id " + std::to_string(object.id) + ": " + why);
@@ -172,19 +165,11 @@ void TrackedObstacleLayer::updateBounds(double, double, double, double* min_x, d
       bounds.expand(b);
     }
   }
-  drawn_min_x_ = drawn_min_y_ = 0.0;
-  drawn_max_x_ = drawn_max_y_ = -1.0;
-  if (!bounds.empty()) {
-    double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
-    g.cellCentre(bounds.min_x, bounds.min_y, &x0, &y0);
-    g.cellCentre(bounds.max_x, bounds.max_y, &x1, &y1);
-    const double half = 0.5 * g.resolution();
-    drawn_min_x_ = x0 - half;
-    drawn_min_y_ = y0 - half;
-    drawn_max_x_ = x1 + half;
-    drawn_max_y_ = y1 + half;
-    grow(drawn_min_x_, drawn_min_y_, drawn_max_x_, drawn_max_y_);
-  }
+  // Remembered in metres: still right after a rolling-window shift of the cells.
+  drawn_min_x_ = drawn_min_y_ = std::numeric_limits<double>::infinity();
+  drawn_max_x_ = drawn_max_y_ = -std::numeric_limits<double>::infinity();
+  g.expandWorldBox(bounds, &drawn_min_x_, &drawn_min_y_, &drawn_max_x_, &drawn_max_y_);
+  grow(drawn_min_x_, drawn_min_y_, drawn_max_x_, drawn_max_y_);
 }
 
 void TrackedObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, int max_i,

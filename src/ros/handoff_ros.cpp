@@ -1,14 +1,15 @@
 #include "downstream_perception/handoff_ros.h"
 
 #include <tf2/utils.h>
-#include <tf2_geometry_msgs/tf2_geometry_msgs.h>
+#include <tf2_geometry_msgs/tf2_geometry_msgs.h>  // PoseStamped in tf2_ros::Buffer::transform
 
 #include <cmath>
 #include <sstream>
 
-#include "downstream_perception/SeamHealth.h"
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/se2.h"
+#include "downstream_perception/tf_failure.h"
+#include "downstream_perception/track_transform.h"
 
 namespace downstream_perception {
 
@@ -16,20 +17,31 @@ HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_, nh), diagnostics_(nh, pnh) {
   loadParameters();
   correction_ = CorrectionMonitor(correction_config_);
+  health_.map_odom_pose_age_s = -1.0;  // no report yet
   std::vector<std::string> scan_topics, track_topics;
   pnh_.param("scan_topics", scan_topics, std::vector<std::string>{});
   pnh_.param("track_topics", track_topics, std::vector<std::string>{});
   for (const std::string& topic : scan_topics) {
-    Input& input = addInput(topic, "LaserScan");
-    Input* p = &input;
-    input.subscriber = nh_.subscribe<sensor_msgs::LaserScan>(
-        topic, 10, [this, p](const sensor_msgs::LaserScanConstPtr& m) { onScan(p, m); });
+    Input* input = &addInput(topic, "LaserScan");
+    input->scans.subscribe(
+        nh_, topic, tf_buffer_, planning_frame_, 20,
+        [this, input](const sensor_msgs::LaserScanConstPtr& m) {
+          recordArrival(input, m->header.stamp);
+        },
+        [this, input](const sensor_msgs::LaserScanConstPtr& m,
+                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+          onTfFailure(input, m->header.frame_id, m->header.stamp, reason);
+        });
   }
   for (const std::string& topic : track_topics) {
-    Input& input = addInput(topic, "TrackedObjectArray");
-    Input* p = &input;
-    input.subscriber = nh_.subscribe<TrackedObjectArray>(
-        topic, 10, [this, p](const TrackedObjectArrayConstPtr& m) { onTracks(p, m); });
+    Input* input = &addInput(topic, "TrackedObjectArray");
+    input->tracks.subscribe(
+        nh_, topic, tf_buffer_, planning_frame_, 20,
+        [this, input](const TrackedObjectArrayConstPtr& m) { onTracks(input, m); },
+        [this, input](const TrackedObjectArrayConstPtr& m,
+                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+          onTfFailure(input, m->header.frame_id, m->header.stamp, reason);
+        });
   }
   goal_publisher_ = pnh_.advertise<geometry_msgs::PoseStamped>("goal_base", 10);
   tracks_publisher_ = pnh_.advertise<TrackedObjectArray>("tracks_planning", 10);
@@ -92,47 +104,33 @@ void HandoffRos::recordArrival(Input* input, const ros::Time& stamp) {
   input->ages.add((ros::Time::now() - stamp).toSec());
 }
 
-void HandoffRos::onScan(Input* input, const sensor_msgs::LaserScanConstPtr& msg) {
-  recordArrival(input, msg->header.stamp);
-  if (!tf_buffer_.canTransform(planning_frame_, msg->header.frame_id, msg->header.stamp,
-                               ros::Duration(0.2))) {
+void HandoffRos::onTfFailure(Input* input, const std::string& frame, const ros::Time& stamp,
+                             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  {
     std::lock_guard<std::mutex> lock(mutex_);
     ++input->tf_failures;
   }
+  ROS_WARN_THROTTLE(2.0, "handoff: %s on %s ('%s' at %f) not placed in '%s': %s",
+                    input->type.c_str(), input->topic.c_str(), frame.c_str(), stamp.toSec(),
+                    planning_frame_.c_str(), tfFailureReason(reason));
 }
 
 void HandoffRos::onTracks(Input* input, const TrackedObjectArrayConstPtr& msg) {
   recordArrival(input, msg->header.stamp);
   geometry_msgs::TransformStamped t;
   try {
-    t = tf_buffer_.lookupTransform(planning_frame_, msg->header.frame_id, msg->header.stamp,
-                                   ros::Duration(0.2));
-  } catch (const tf2::TransformException& e) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++input->tf_failures;
-    }
-    ROS_WARN_THROTTLE(2.0, "handoff: tracks on %s not placed at their stamp: %s",
-                      input->topic.c_str(), e.what());
+    // Released by the MessageFilter: the transform at the stamp exists.
+    t = tf_buffer_.lookupTransform(planning_frame_, msg->header.frame_id, msg->header.stamp);
+  } catch (const tf2::TransformException&) {
+    onTfFailure(input, msg->header.frame_id, msg->header.stamp,
+                tf2_ros::filter_failure_reasons::Unknown);
     return;
   }
-  TrackedObjectArray out = *msg;
+  TrackedObjectArray out;
+  out.header = msg->header;
   out.header.frame_id = planning_frame_;  // the stamp stays the measurement's
-  const double yaw = tf2::getYaw(t.transform.rotation);
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  for (TrackedObject& o : out.tracks) {
-    tf2::doTransform(o.position, o.position, t);
-    const double vx = o.velocity.x, vy = o.velocity.y;
-    o.velocity.x = c * vx - s * vy;
-    o.velocity.y = s * vx + c * vy;
-    // Covariances rotate as R S R^T.
-    for (auto* m : {&o.position_covariance, &o.velocity_covariance}) {
-      const double a = (*m)[0], b = (*m)[1], d = (*m)[3];
-      (*m)[0] = c * c * a - 2 * c * s * b + s * s * d;
-      (*m)[1] = (*m)[2] = c * s * (a - d) + (c * c - s * s) * b;
-      (*m)[3] = s * s * a + 2 * c * s * b + c * c * d;
-    }
-  }
+  out.tracks.reserve(msg->tracks.size());
+  for (const TrackedObject& o : msg->tracks) out.tracks.push_back(transformTrack(o, t));
   tracks_publisher_.publish(out);
 }
 
@@ -212,23 +210,25 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (have_rate) yaw_rate_rps_ = yaw_rate;
-    warnings_.clear();
+    health.yaw_rate_rps = yaw_rate_rps_;
     if (have_correction) {
-      correction_m_ =
+      health.map_odom_correction_m =
           std::hypot(map_odom.transform.translation.x, map_odom.transform.translation.y);
-      correction_yaw_ = tf2::getYaw(map_odom.transform.rotation);
+      health.map_odom_correction_yaw_rad = tf2::getYaw(map_odom.transform.rotation);
       // A static map <- odom (stamp 0) has no age.
-      map_odom_age_s_ =
+      health.map_odom_pose_age_s =
           map_odom.header.stamp.isZero() ? -1.0 : (now - map_odom.header.stamp).toSec();
-      correction_.add(now.toSec(), correction_m_, travelled_m_);
-      if (map_odom_age_s_ > max_map_odom_age_s_) {
-        warnings_.push_back("map<-odom is " + toText(map_odom_age_s_) +
-                            " s old (localisation stopped?)");
+      correction_.add(now.toSec(), health.map_odom_correction_m, travelled_m_);
+      if (health.map_odom_pose_age_s > max_map_odom_age_s_) {
+        health.warnings.push_back("map<-odom is " + toText(health.map_odom_pose_age_s) +
+                                  " s old (localisation stopped?)");
       }
-      for (const std::string& f : correction_.findings()) warnings_.push_back(f);
+      for (const std::string& f : correction_.findings()) health.warnings.push_back(f);
     } else {
-      warnings_.push_back("no transform '" + planning_frame_ + "' <- '" + odom_frame_ + "'");
+      health.map_odom_pose_age_s = -1.0;
+      health.warnings.push_back("no transform '" + planning_frame_ + "' <- '" + odom_frame_ + "'");
     }
+    health.map_odom_resets = static_cast<std::uint32_t>(correction_.resets());
     for (const auto& input : inputs_) {
       SeamInput in;
       in.topic = input->topic;
@@ -241,21 +241,16 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
       in.expected_smear_m =
           expectedSmear(reference_range_m_, yaw_rate_rps_, in.transform_age_p95_s);
       if (in.transform_age_p95_s > max_transform_age_s_) {
-        warnings_.push_back(in.topic + ": transform age p95 " + toText(in.transform_age_p95_s) +
-                            " s > max_transform_age_s");
+        health.warnings.push_back(in.topic + ": transform age p95 " +
+                                  toText(in.transform_age_p95_s) + " s > max_transform_age_s");
       }
       if (in.expected_smear_m > max_smear_m_) {
-        warnings_.push_back(in.topic + ": expected smear " + toText(in.expected_smear_m) +
-                            " m at " + toText(reference_range_m_) + " m > max_smear_m");
+        health.warnings.push_back(in.topic + ": expected smear " + toText(in.expected_smear_m) +
+                                  " m at " + toText(reference_range_m_) + " m > max_smear_m");
       }
       health.inputs.push_back(in);
     }
-    health.yaw_rate_rps = yaw_rate_rps_;
-    health.map_odom_correction_m = correction_m_;
-    health.map_odom_correction_yaw_rad = correction_yaw_;
-    health.map_odom_pose_age_s = map_odom_age_s_;
-    health.map_odom_resets = static_cast<std::uint32_t>(correction_.resets());
-    health.warnings = warnings_;
+    health_ = health;
   }
   health_publisher_.publish(health);
   diagnostics_.force_update();
@@ -265,28 +260,26 @@ void HandoffRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
   status.add("planning_frame", planning_frame_);
   status.add("robot_base_frame", robot_base_frame_);
-  status.add("yaw rate (rad/s)", yaw_rate_rps_);
-  for (const auto& input : inputs_) {
-    const double p95 = input->ages.percentile(0.95);
-    status.add(input->topic + " messages", input->ages.total());
-    status.add(input->topic + " tf failures", input->tf_failures);
-    status.add(input->topic + " transform age p50 (s)", input->ages.percentile(0.5));
-    status.add(input->topic + " transform age p95 (s)", p95);
-    status.add(input->topic + " expected smear at reference range (m)",
-               expectedSmear(reference_range_m_, yaw_rate_rps_, p95));
+  status.add("yaw rate (rad/s)", health_.yaw_rate_rps);
+  for (const SeamInput& in : health_.inputs) {
+    status.add(in.topic + " messages", in.messages);
+    status.add(in.topic + " tf failures", in.tf_failures);
+    status.add(in.topic + " transform age p50 (s)", in.transform_age_p50_s);
+    status.add(in.topic + " transform age p95 (s)", in.transform_age_p95_s);
+    status.add(in.topic + " expected smear at reference range (m)", in.expected_smear_m);
   }
-  status.add("map<-odom correction (m)", correction_m_);
-  status.add("map<-odom correction yaw (rad)", correction_yaw_);
-  status.add("map<-odom age (s, -1 static)", map_odom_age_s_);
-  status.add("map<-odom resets", correction_.resets());
+  status.add("map<-odom correction (m)", health_.map_odom_correction_m);
+  status.add("map<-odom correction yaw (rad)", health_.map_odom_correction_yaw_rad);
+  status.add("map<-odom age (s, -1 static)", health_.map_odom_pose_age_s);
+  status.add("map<-odom resets", health_.map_odom_resets);
   status.add("goals handed down", goals_);
   status.add("goals dropped (no transform at stamp)", goal_failures_);
   if (!last_goal_failure_.empty()) status.add("last goal failure", last_goal_failure_);
   addConfigErrors(status, config_errors_);
   if (!config_errors_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
-  } else if (!warnings_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, warnings_.front());
+  } else if (!health_.warnings.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, health_.warnings.front());
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "seam healthy");
   }

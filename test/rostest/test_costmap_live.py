@@ -27,7 +27,7 @@ from tf2_ros import StaticTransformBroadcaster, TransformBroadcaster
 
 from downstream_perception import ros_util
 from downstream_perception.costmap_client import CostmapClient
-from downstream_perception.ros_util import transform_stamped
+from downstream_perception.ros_util import laser_scan, transform_stamped
 
 WALL_X = 2.025  # a cell centre: no float rounding decides the cell
 N_BEAMS = 720
@@ -84,15 +84,9 @@ class Robot:
             rate.sleep()
 
     def _publish_scan(self, robot_x: float, stamp: rospy.Time) -> None:
-        msg = LaserScan()
-        msg.header.stamp = stamp
-        msg.header.frame_id = "laser"
-        msg.angle_min = -math.pi
-        msg.angle_increment = 2 * math.pi / N_BEAMS
-        msg.angle_max = msg.angle_min + (N_BEAMS - 1) * msg.angle_increment
-        msg.range_min = 0.05
-        msg.range_max = 30.0
-        msg.ranges = scan_ranges(robot_x).tolist()
+        msg = laser_scan(
+            stamp, "laser", scan_ranges(robot_x), -math.pi, 2 * math.pi / N_BEAMS, 0.05, 30.0
+        )
         self.scan_pub.publish(msg)
 
     def _publish_cloud(self, stamp: rospy.Time) -> None:

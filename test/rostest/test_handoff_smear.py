@@ -28,7 +28,7 @@ from tf2_ros import StaticTransformBroadcaster, TransformBroadcaster
 
 from downstream_perception.costmap_client import CostmapClient
 from downstream_perception.msg import SeamHealth
-from downstream_perception.ros_util import transform_stamped, wait_until
+from downstream_perception.ros_util import laser_scan, transform_stamped, wait_until
 from downstream_perception.srv import TransformPose
 
 YAW_RATE = math.radians(90.0)
@@ -95,15 +95,8 @@ class HandoffSmearTest(unittest.TestCase):
     def scan(cls) -> None:
         while cls.running and not rospy.is_shutdown():
             stamp = rospy.Time.now()
-            msg = LaserScan()
-            msg.header.stamp = stamp
-            msg.header.frame_id = "base_link"
-            msg.angle_min = -math.pi
-            msg.angle_increment = 2 * math.pi / BEAMS
-            msg.angle_max = msg.angle_min + (BEAMS - 1) * msg.angle_increment
-            msg.range_min = 0.1
-            msg.range_max = 10.0
-            msg.ranges = ranges_at(cls.yaw_at(stamp)).astype(np.float32).tolist()
+            ranges = ranges_at(cls.yaw_at(stamp))
+            msg = laser_scan(stamp, "base_link", ranges, -math.pi, 2 * math.pi / BEAMS, 0.1, 10.0)
             time.sleep(LATENCY)  # the scan reaches the network 30 ms after its stamp
             cls.scan_pub.publish(msg)
             time.sleep(0.1 - LATENCY)

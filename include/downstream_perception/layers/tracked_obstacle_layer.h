@@ -18,8 +18,8 @@
 
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
+#include "downstream_perception/filtered_subscription.h"
 #include "downstream_perception/layer.h"
-#include "downstream_perception/layers/observation_source.h"
 #include "downstream_perception/running_stats.h"
 
 namespace downstream_perception {
