@@ -95,6 +95,7 @@ try:
         predicted_cells,
         probability_of,
         ray_cells,
+        recent_cells,
         shortest_angular_distance,
         solve_assignment,
         swept_polygon,

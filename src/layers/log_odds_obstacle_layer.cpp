@@ -17,11 +17,17 @@ namespace downstream_perception {
 namespace {
 // Decay runs at most this often: each pass scans the evidence box once.
 constexpr double kMinDecayPeriodS = 0.1;
+// Tracked-object clearing reaches this far behind the older of (the track's stamp, the previous
+// clearing): a scan integrated since the previous update may be stamped up to its latency earlier.
+constexpr double kClearingSensorLatencyS = 0.1;
+// ... and never further back than this (the first clearing, a long pause).
+constexpr double kMaxClearingLookbackS = 1.0;
 }  // namespace
 
 LogOddsObstacleLayer::~LogOddsObstacleLayer() {
   // Stop the callbacks before the grid they write into goes away.
   reconfigure_server_.reset();
+  track_inbox_.unsubscribe();
   sources_.clear();
 }
 
@@ -35,6 +41,19 @@ void LogOddsObstacleLayer::onInitialize() {
   nh_.param("track_unknown_space", track_unknown_space_, layered_costmap_->isTrackingUnknown());
   grid_ = LogOddsGrid(layered_costmap_->costmap().geometry(), grid_config_);
   readSources();
+  TrackInboxConfig tracks;
+  tracks.include_tentative = false;  // only confirmed tracks: a tentative one may be clutter and
+  tracks.include_coasting = false;   // a coasting one is not where the sensor sees its returns
+  nh_.param("tracks_topic", tracks.topic, tracks.topic);
+  nh_.param("track_timeout_s", tracks.track_timeout_s, tracks.track_timeout_s);
+  nh_.param("tracks_tf_queue_size", tracks.tf_queue_size, tracks.tf_queue_size);
+  const std::string why = tracks.validate();
+  if (!why.empty()) {
+    reportError("tracks for clear_tracked_objects: " + why + "; using the defaults");
+    tracks = TrackInboxConfig();
+    tracks.include_coasting = false;
+  }
+  track_inbox_.setConfig(tracks);
   // The server reads the YAML values (or the .cfg defaults, equal to the C++ ones) and calls
   // reconfigure() once at once: one code path for start-up and live changes.
   reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
@@ -72,6 +91,15 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
                 std::to_string(config_.decay_time_s));
   }
   layer.footprint_clearing_enabled = cfg.footprint_clearing_enabled;
+  layer.clear_tracked_objects = cfg.clear_tracked_objects;
+  if (std::isfinite(cfg.tracked_clearing_margin_m) && cfg.tracked_clearing_margin_m >= 0.0 &&
+      cfg.tracked_clearing_margin_m <= 2.0) {
+    layer.tracked_clearing_margin_m = cfg.tracked_clearing_margin_m;
+  } else {
+    reportError("tracked_clearing_margin_m must be in [0, 2] m, got " +
+                std::to_string(cfg.tracked_clearing_margin_m) + "; keeping " +
+                std::to_string(config_.tracked_clearing_margin_m));
+  }
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
     grid_config_ = model;
@@ -84,7 +112,8 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   markAllDirty();
   const bool was_enabled = enabled_;
   enabled_ = cfg.enabled;
-  // Subscribed exactly while enabled (activate/deactivate are idempotent).
+  // Subscribed exactly while enabled (activate/deactivate are idempotent); the tracks while
+  // clear_tracked_objects is on, too.
   if (enabled_) {
     activate();
   } else {
@@ -94,10 +123,15 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   if (was_enabled != enabled_) layered_costmap_->requestFullRedraw();
   ROS_INFO(
       "layer '%s': p_hit %.3f p_miss %.3f, log-odds in [%.2f, %.2f], occupied > %.2f, "
-      "free < %.2f, combination %d, footprint clearing %s, decay time %.2f s, %s",
+      "free < %.2f, combination %d, footprint clearing %s, decay time %.2f s, tracked-object "
+      "clearing %s, %s",
       name_.c_str(), model.p_hit, model.p_miss, model.clamp_min, model.clamp_max,
       model.occupied_threshold, model.free_threshold, static_cast<int>(layer.combination_method),
       layer.footprint_clearing_enabled ? "on" : "off", layer.decay_time_s,
+      layer.clear_tracked_objects ? ("on (" + track_inbox_.config().topic + ", margin " +
+                                     std::to_string(layer.tracked_clearing_margin_m) + " m)")
+                                        .c_str()
+                                  : "off",
       enabled_ ? "enabled" : "disabled");
 }
 
@@ -219,6 +253,35 @@ void LogOddsObstacleLayer::decay() {
   cells_decayed_to_unknown_ += changed;
 }
 
+void LogOddsObstacleLayer::clearTrackedObjects() {
+  // A confirmed track is drawn by the TrackedObstacleLayer as its prediction; its own returns
+  // here would draw it a second time, and leave a trail behind it until enough misses clear
+  // them. Positive evidence under the box's recent path goes back to unknown (not free: nothing
+  // says the floor under a forklift is free). Caller holds grid_mutex_.
+  const ros::Time now = ros::Time::now();
+  const FreshTracks fresh = track_inbox_.fresh(now);
+  const double since_last =
+      last_track_clearing_.isZero() ? 0.0 : std::max(0.0, (now - last_track_clearing_).toSec());
+  last_track_clearing_ = now;
+  tracks_cleared_last_ = 0;
+  const double lookback = std::min(
+      kMaxClearingLookbackS, std::max(0.0, since_last - fresh.age_s) + kClearingSensorLatencyS);
+  for (const PlanarTrack& t : fresh.tracks) {
+    footprint_scratch_.clear();
+    const CellBounds b =
+        recentCells(t, lookback, fresh.age_s, config_.tracked_clearing_margin_m,
+                    PredictionConfig().max_object_size_m, grid_.geometry(), &footprint_scratch_);
+    tracks_cleared_last_ += !b.empty();
+    for (const std::size_t i : footprint_scratch_) {
+      if (grid_.units(i) <= 0) continue;
+      grid_.setLogOdds(i, 0.0);
+      const CellIndex c = grid_.geometry().cellOf(i);
+      dirty_.expand(c.x, c.y);
+      ++tracked_cells_cleared_;
+    }
+  }
+}
+
 void LogOddsObstacleLayer::updateBounds(double robot_x, double robot_y, double robot_yaw,
                                         double* min_x, double* min_y, double* max_x,
                                         double* max_y) {
@@ -230,6 +293,7 @@ void LogOddsObstacleLayer::updateBounds(double robot_x, double robot_y, double r
   if (config_.footprint_clearing_enabled && layered_costmap_->hasRobotPose()) {
     clearFootprint(robot_x, robot_y, robot_yaw);
   }
+  if (config_.clear_tracked_objects) clearTrackedObjects();
   grid_.geometry().expandWorldBox(dirty_, min_x, min_y, max_x, max_y);
   dirty_ = CellBounds{};
 }
@@ -289,10 +353,21 @@ void LogOddsObstacleLayer::reset() {
 
 void LogOddsObstacleLayer::activate() {
   for (auto& source : sources_) source->subscribe();
+  bool clear_tracked = false;
+  {
+    std::lock_guard<std::mutex> lock(grid_mutex_);
+    clear_tracked = config_.clear_tracked_objects;
+  }
+  if (clear_tracked) {
+    track_inbox_.subscribe(nh_, *tf_, layered_costmap_->globalFrame(), name_);
+  } else {
+    track_inbox_.unsubscribe();
+  }
 }
 
 void LogOddsObstacleLayer::deactivate() {
   for (auto& source : sources_) source->unsubscribe();
+  track_inbox_.unsubscribe();
 }
 
 void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -302,6 +377,8 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   double max_abs = 0.0;
   std::size_t decayed = 0;
   std::size_t footprint_cleared = 0;
+  std::size_t tracked_cleared = 0;
+  std::size_t tracks_cleared = 0;
   ObstacleLayerConfig config;
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
@@ -309,6 +386,8 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     max_abs = grid_.maxAbsLogOdds();
     decayed = cells_decayed_to_unknown_;
     footprint_cleared = footprint_cells_cleared_;
+    tracked_cleared = tracked_cells_cleared_;
+    tracks_cleared = tracks_cleared_last_;
     config = config_;
   }
   std::size_t rejected_total = 0;
@@ -354,6 +433,12 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   status.add("combination method", static_cast<int>(config.combination_method));
   status.add("footprint clearing", config.footprint_clearing_enabled);
   status.add("footprint cells cleared (total)", footprint_cleared);
+  status.add("clear tracked objects", config.clear_tracked_objects);
+  if (config.clear_tracked_objects) {
+    track_inbox_.diagnose(status, "tracks: ");
+    status.add("tracks cleared (last update)", tracks_cleared);
+    status.add("cells cleared under tracks (total)", tracked_cleared);
+  }
   status.add("decay time (s)", config.decay_time_s);
   status.add("cells decayed to another state (total)", decayed);
   status.add("memory (bytes)", grid_.memoryBytes());

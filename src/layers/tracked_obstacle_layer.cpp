@@ -1,149 +1,100 @@
 #include "downstream_perception/layers/tracked_obstacle_layer.h"
 
-#include <tf2/utils.h>
 #include <pluginlib/class_list_macros.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/layered_costmap.h"
-#include "downstream_perception/tf_failure.h"
-#include "downstream_perception/track_transform.h"
 
 namespace downstream_perception {
 
-namespace {
-
-Eigen::Matrix2d covariance2(const boost::array<double, 4>& row_major) {
-  Eigen::Matrix2d m;
-  m << row_major[0], row_major[1], row_major[2], row_major[3];
-  return m;
+TrackedObstacleLayer::~TrackedObstacleLayer() {
+  // Stop the callbacks before the state they write into goes away.
+  reconfigure_server_.reset();
+  inbox_.unsubscribe();
 }
 
-}  // namespace
+void TrackedObstacleLayer::reportError(const std::string& msg) {
+  ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
+  std::lock_guard<std::mutex> lock(mutex_);
+  config_errors_.push_back(msg);
+}
 
 void TrackedObstacleLayer::onInitialize() {
-  nh_.param("topic", topic_, std::string("/tracker/tracks"));
-  nh_.param("enabled", enabled_, true);
-  nh_.param("prediction_horizon_s", prediction_.prediction_horizon_s,
-            prediction_.prediction_horizon_s);
-  nh_.param("uncertainty_sigmas", prediction_.uncertainty_sigmas, prediction_.uncertainty_sigmas);
-  nh_.param("max_uncertainty_m", prediction_.max_uncertainty_m, prediction_.max_uncertainty_m);
-  nh_.param("min_object_size_m", prediction_.min_object_size_m, prediction_.min_object_size_m);
-  nh_.param("max_object_size_m", prediction_.max_object_size_m, prediction_.max_object_size_m);
-  nh_.param("max_speed_mps", prediction_.max_speed_mps, prediction_.max_speed_mps);
-  nh_.param("track_timeout_s", track_timeout_s_, track_timeout_s_);
-  nh_.param("include_tentative", include_tentative_, include_tentative_);
-  nh_.param("include_coasting", include_coasting_, include_coasting_);
-  nh_.param("tf_queue_size", tf_queue_size_, tf_queue_size_);
-  const std::string why = prediction_.validate();
+  TrackInboxConfig inbox;
+  nh_.param("topic", inbox.topic, inbox.topic);
+  nh_.param("tf_queue_size", inbox.tf_queue_size, inbox.tf_queue_size);
+  const std::string why = inbox.validate();
   if (!why.empty()) {
-    config_errors_.push_back(why + "; using the defaults");
-    prediction_ = PredictionConfig();
+    reportError(why + "; using the defaults");
+    inbox = TrackInboxConfig();
   }
-  if (!(std::isfinite(track_timeout_s_) && track_timeout_s_ > 0.0)) {
-    config_errors_.push_back("parameter track_timeout_s = " + toText(track_timeout_s_) +
-                             " must be > 0 s; using 1.0");
-    track_timeout_s_ = 1.0;
-  }
-  if (tf_queue_size_ < 1) {
-    config_errors_.push_back("parameter tf_queue_size = " + toText(tf_queue_size_) +
-                             " must be >= 1; using 20");
-    tf_queue_size_ = 20;
-  }
-  for (const std::string& e : config_errors_) ROS_ERROR("layer '%s': %s", name_.c_str(), e.c_str());
+  inbox_.setConfig(inbox);
   current_ = false;
-  subscribe();
-  ROS_INFO("layer '%s': tracks from %s, horizon %.2f s, timeout %.2f s", name_.c_str(),
-           ros::names::resolve(nh_.getNamespace(), topic_).c_str(),
-           prediction_.prediction_horizon_s, track_timeout_s_);
+  // The server reads the YAML values (or the .cfg defaults, equal to the C++ ones) and calls
+  // reconfigure() at once: one code path for start-up and live changes.
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
+  reconfigure_server_->setCallback(boost::bind(&TrackedObstacleLayer::reconfigure, this,
+                                               boost::placeholders::_1, boost::placeholders::_2));
 }
 
-void TrackedObstacleLayer::subscribe() {
-  subscription_.subscribe(
-      nh_, topic_, *tf_, layered_costmap_->globalFrame(), tf_queue_size_,
-      [this](const TrackedObjectArrayConstPtr& msg) { onTracks(msg); },
-      [this](const TrackedObjectArrayConstPtr& msg,
-             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-        std::ostringstream detail;
-        detail << "frame '" << msg->header.frame_id << "' -> '" << layered_costmap_->globalFrame()
-               << "' at stamp " << msg->header.stamp;
-        reject(tfFailureReason(reason), detail.str());
-      });
-}
-
-void TrackedObstacleLayer::reject(const std::string& reason, const std::string& detail) {
+void TrackedObstacleLayer::reconfigure(TrackedObstacleLayerConfig& cfg, std::uint32_t) {
+  PredictionConfig prediction;
+  prediction.prediction_horizon_s = cfg.prediction_horizon_s;
+  prediction.uncertainty_sigmas = cfg.uncertainty_sigmas;
+  prediction.max_uncertainty_m = cfg.max_uncertainty_m;
+  prediction.min_object_size_m = cfg.min_object_size_m;
+  prediction.max_object_size_m = cfg.max_object_size_m;
+  prediction.max_speed_mps = cfg.max_speed_mps;
+  PredictionConfig previous;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++rejected_[reason];
-    last_rejection_ = reason + ": " + detail;
+    previous = prediction_;
   }
-  ROS_WARN_THROTTLE(2.0, "layer '%s' (%s): %s: %s", name_.c_str(), topic_.c_str(), reason.c_str(),
-                    detail.c_str());
-}
-
-void TrackedObstacleLayer::onTracks(const TrackedObjectArrayConstPtr& msg) {
-  const std::string& global = layered_costmap_->globalFrame();
-  geometry_msgs::TransformStamped transform;
-  try {
-    transform = tf_->lookupTransform(global, msg->header.frame_id, msg->header.stamp);
-  } catch (const tf2::TransformException& e) {
-    reject("tf: lookup at stamp failed", e.what());
-    return;
+  std::string why = prediction.validate();
+  if (!why.empty()) {
+    reportError(why + "; keeping the previous prediction settings (horizon " +
+                toText(previous.prediction_horizon_s) + " s)");
+    prediction = previous;
   }
-  const double box_yaw = tf2::getYaw(transform.transform.rotation);
-  std::vector<PlanarTrack> tracks;
-  std::size_t skipped_state = 0;
-  for (const TrackedObject& object : msg->tracks) {
-    const bool wanted = object.state == TrackedObject::CONFIRMED ||
-                        (include_coasting_ && object.state == TrackedObject::COASTING) ||
-                        (include_tentative_ && object.state == TrackedObject::TENTATIVE);
-    if (!wanted) {
-      ++skipped_state;
-      continue;
-    }
-    const TrackedObject placed = transformTrack(object, transform);
-    PlanarTrack t;
-    t.position = {placed.position.x, placed.position.y};
-    t.velocity = {placed.velocity.x, placed.velocity.y};
-    t.position_covariance = covariance2(placed.position_covariance);
-    t.velocity_covariance = covariance2(placed.velocity_covariance);
-    t.size_x = object.size_x;
-    t.size_y = object.size_y;
-    t.box_yaw = box_yaw;
-    const std::string why = t.validate();
-    if (!why.empty()) {
-      reject("bad track", "id " + std::to_string(object.id) + ": " + why);
-      continue;
-    }
-    tracks.push_back(t);
+  TrackInboxConfig inbox = inbox_.config();
+  const double previous_timeout = inbox.track_timeout_s;
+  inbox.track_timeout_s = cfg.track_timeout_s;
+  inbox.include_tentative = cfg.include_tentative;
+  inbox.include_coasting = cfg.include_coasting;
+  why = inbox.validate();
+  if (!why.empty()) {
+    reportError(why + "; keeping " + toText(previous_timeout) + " s");
+    inbox.track_timeout_s = previous_timeout;
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!tracks_stamp_.isZero() && msg->header.stamp < tracks_stamp_) {
-    ++rejected_["older than the tracks already drawn"];
-    return;
+  inbox_.setConfig(inbox);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    prediction_ = prediction;
   }
-  tracks_ = std::move(tracks);
-  tracks_stamp_ = msg->header.stamp;
-  tracks_skipped_state_ += skipped_state;
-  ++arrays_received_;
-  transform_age_s_.add((ros::Time::now() - msg->header.stamp).toSec());
+  const bool was_enabled = enabled_;
+  enabled_ = cfg.enabled;
+  // Subscribed exactly while enabled.
+  if (enabled_) {
+    activate();
+  } else {
+    deactivate();
+  }
+  if (was_enabled != enabled_) layered_costmap_->requestFullRedraw();
+  ROS_INFO("layer '%s': tracks from %s, horizon %.2f s, %.1f sigma, timeout %.2f s, %s",
+           name_.c_str(), ros::names::resolve(nh_.getNamespace(), inbox.topic).c_str(),
+           prediction.prediction_horizon_s, prediction.uncertainty_sigmas, inbox.track_timeout_s,
+           enabled_ ? "enabled" : "disabled");
 }
 
 void TrackedObstacleLayer::updateBounds(double, double, double, double* min_x, double* min_y,
                                         double* max_x, double* max_y) {
+  const FreshTracks fresh = inbox_.fresh(ros::Time::now());
   std::lock_guard<std::mutex> lock(mutex_);
-  const ros::Time now = ros::Time::now();
-  const bool fresh = !tracks_stamp_.isZero() && (now - tracks_stamp_).toSec() <= track_timeout_s_;
-  current_ = fresh;
-  if (!fresh && !tracks_.empty()) {
-    tracks_.clear();  // a stale track never stays in the map
-    ++arrays_expired_;
-  }
+  current_ = !fresh.stamp.isZero() && fresh.age_s <= inbox_.config().track_timeout_s;
   const auto grow = [&](double x0, double y0, double x1, double y1) {
     if (x0 > x1) return;
     *min_x = std::min(*min_x, x0);
@@ -158,9 +109,8 @@ void TrackedObstacleLayer::updateBounds(double, double, double, double* min_x, d
   CellBounds bounds;
   const GridGeometry& g = layered_costmap_->costmap().geometry();
   if (enabled_ && g.cellCount() > 0) {
-    const double age = std::max(0.0, (now - tracks_stamp_).toSec());
-    for (const PlanarTrack& t : tracks_) {
-      const CellBounds b = predictedCells(t, age, prediction_, g, &cells_);
+    for (const PlanarTrack& t : fresh.tracks) {
+      const CellBounds b = predictedCells(t, fresh.age_s, prediction_, g, &cells_);
       tracks_drawn_ += !b.empty();
       bounds.expand(b);
     }
@@ -192,43 +142,35 @@ void TrackedObstacleLayer::matchSize() {
 }
 
 void TrackedObstacleLayer::reset() {
+  inbox_.clear();
   std::lock_guard<std::mutex> lock(mutex_);
-  tracks_.clear();
   cells_.clear();
 }
 
 void TrackedObstacleLayer::activate() {
-  subscribe();
+  inbox_.subscribe(nh_, *tf_, layered_costmap_->globalFrame(), name_);
 }
 
 void TrackedObstacleLayer::deactivate() {
-  subscription_.unsubscribe();
+  inbox_.unsubscribe();
 }
 
 void TrackedObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  inbox_.diagnose(status);
   std::lock_guard<std::mutex> lock(mutex_);
-  status.add("topic", topic_);
-  status.add("track arrays received", arrays_received_);
-  status.add("track arrays expired (older than track_timeout_s)", arrays_expired_);
-  status.add("tracks skipped by state", tracks_skipped_state_);
-  std::size_t rejected = 0;
-  for (const auto& [reason, count] : rejected_) {
-    status.add("rejected (" + reason + ")", count);
-    rejected += count;
-  }
-  if (!last_rejection_.empty()) status.add("last rejection", last_rejection_);
   status.add("tracks drawn (last update)", tracks_drawn_);
   status.add("lethal cells drawn (last update)", cells_.size());
-  status.add("transform age mean (s)", transform_age_s_.mean());
-  status.add("transform age max (s)", transform_age_s_.max);
   status.add("prediction_horizon_s", prediction_.prediction_horizon_s);
   addConfigErrors(status, config_errors_);
   if (!config_errors_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
-  } else if (arrays_received_ == 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   rejected > 0 ? "every track array rejected: " + last_rejection_
-                                : "no track array received yet");
+  } else if (!enabled_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "disabled");
+  } else if (inbox_.arraysReceived() == 0) {
+    const std::string last = inbox_.lastRejection();
+    status.summary(
+        diagnostic_msgs::DiagnosticStatus::WARN,
+        last.empty() ? "no track array received yet" : "every track array rejected: " + last);
   } else if (!current_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    "tracks older than track_timeout_s: none drawn");

@@ -579,6 +579,21 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("track"), py::arg("age_s"), py::arg("config"), py::arg("geometry"),
       "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s.");
+  m.def(
+      "recent_cells",
+      [](const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
+         double max_object_size_m, const GridGeometry& geometry) {
+        std::vector<std::size_t> cells;
+        recentCells(track, lookback_s, age_s, margin_m, max_object_size_m, geometry, &cells);
+        std::vector<CellIndex> xy;
+        xy.reserve(cells.size());
+        for (const std::size_t i : cells) xy.push_back(geometry.cellOf(i));
+        return cellsToArray(xy);
+      },
+      py::arg("track"), py::arg("lookback_s"), py::arg("age_s"), py::arg("margin_m"),
+      py::arg("max_object_size_m"), py::arg("geometry"),
+      "Cells (N x 2 [x, y]) under the track's box grown by margin_m, swept from lookback_s before "
+      "its stamp to age_s after it (what clear_tracked_objects clears).");
 
   m.def("chi_square_quantile", &chiSquareQuantile, py::arg("dof"), py::arg("confidence"),
         "Squared-Mahalanobis gate: chi-square quantile (2, 0.99) -> 9.21.");

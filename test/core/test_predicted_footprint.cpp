@@ -212,3 +212,39 @@ TEST(PredictedFootprint, BadTracksAndConfigsAreRefused) {
   c.max_object_size_m = 1.0;
   EXPECT_NE(c.validate().find("min_object_size_m"), std::string::npos);
 }
+
+TEST(PredictedFootprint, RecentCellsCoverTheGrownBoxFromLookbackToNow) {
+  const GridGeometry g(200, 100, 0.05, 0.0, 0.0);
+  PlanarTrack t;
+  t.position = {5.0, 2.0};
+  t.velocity = {1.0, 0.0};
+  t.size_x = 1.0;
+  t.size_y = 0.6;
+  std::vector<std::size_t> cells;
+  // 0.1 s back and 0.1 s on at 1 m/s, grown 0.1 m: x in [4.3, 5.7], y in [1.6, 2.4].
+  const CellBounds b = recentCells(t, 0.1, 0.1, 0.1, 5.0, g, &cells);
+  EXPECT_EQ(b.min_x, 86);              // centre 4.325
+  EXPECT_EQ(b.max_x, 113);             // centre 5.675
+  EXPECT_EQ(b.min_y, 32);              // centre 1.625
+  EXPECT_EQ(b.max_y, 47);              // centre 2.375
+  EXPECT_EQ(cells.size(), 28u * 16u);  // a full rectangle: the sweep of an axis-aligned box
+  // Nothing ahead of where the object is now: clearing must not reach where it is going.
+  for (const std::size_t i : cells) EXPECT_LE(g.cellOf(i).x, 113);
+}
+
+TEST(PredictedFootprint, RecentCellsClampAbsurdSizesAndRefuseBadArguments) {
+  const GridGeometry g(200, 200, 0.05, 0.0, 0.0);
+  PlanarTrack t;
+  t.position = {5.0, 5.0};
+  t.size_x = t.size_y = 1000.0;  // a broken size estimate must not blank the map
+  std::vector<std::size_t> cells;
+  const CellBounds b = recentCells(t, 0.0, 0.0, 0.0, 1.0, g, &cells);
+  EXPECT_EQ(b.max_x - b.min_x + 1, 20);  // 1.0 m
+  EXPECT_EQ(cells.size(), 400u);
+  cells.clear();
+  EXPECT_TRUE(recentCells(t, -0.1, 0.0, 0.0, 1.0, g, &cells).empty());
+  EXPECT_TRUE(recentCells(t, 0.0, 0.0, std::nan(""), 1.0, g, &cells).empty());
+  t.velocity.x() = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(recentCells(t, 0.0, 0.0, 0.0, 1.0, g, &cells).empty());
+  EXPECT_TRUE(cells.empty());
+}

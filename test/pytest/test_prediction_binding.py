@@ -91,3 +91,44 @@ def test_bad_tracks_give_no_cells() -> None:
     assert dp.predicted_cells(fast, 0.0, config, grid).shape == (0, 2)
     config.prediction_horizon_s = -1.0
     assert "prediction_horizon_s" in config.validate()
+
+
+def test_recent_cells_cover_where_the_object_was_not_where_it_goes() -> None:
+    grid = dp.GridGeometry(160, 160, 0.05, 0.0, 0.0)
+    track = dp.PlanarTrack([4.0, 4.0], [0.5, 0.0], size_x=0.6, size_y=0.4, box_yaw=0.3)
+    lookback, age, margin = 0.4, 0.2, 0.1
+    cells = set(map(tuple, dp.recent_cells(track, lookback, age, margin, 5.0, grid).tolist()))
+    # The same as the box grown by the margin, swept from 0.4 s before the stamp to 0.2 s after,
+    # rasterised independently: the hull of the grown box at both ends.
+    c, s = math.cos(0.3), math.sin(0.3)
+    hx, hy = 0.3 + margin, 0.2 + margin
+    corners = []
+    for dt in (-lookback, age):
+        cx, cy = 4.0 + 0.5 * dt, 4.0
+        corners += [(cx + c * a - s * b, cy + s * a + c * b) for a in (-hx, hx) for b in (-hy, hy)]
+    polygon = convex_hull(np.array(corners))
+    assert cells == rasterise(polygon, 0.0, grid)
+    # Nothing beyond where the object is now (the prediction's business, not the clearing's).
+    front = 4.0 + 0.5 * age + c * hx + s * hy
+    assert max(x for x, _ in cells) * 0.05 <= front
+    assert dp.recent_cells(track, -1.0, age, margin, 5.0, grid).shape == (0, 2)
+
+
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Counter-clockwise hull (Andrew's monotone chain), for the test's own rasterisation."""
+    pts = sorted(map(tuple, points.tolist()))
+
+    def half(seq: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        out: list[tuple[float, float]] = []
+        for p in seq:
+            while len(out) >= 2 and (
+                (out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])
+                <= 0
+            ):
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(pts), half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])

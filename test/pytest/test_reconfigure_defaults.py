@@ -72,3 +72,27 @@ def test_tracker_defaults_match_tracker_config_and_yaml() -> None:
     documented = yaml.safe_load((Path(__file__).parents[2] / "cfg" / "tracker.yaml").read_text())
     for name, value in d.items():
         assert documented[name] == pytest.approx(value), name
+
+
+def test_tracked_obstacle_layer_defaults_match_prediction_config() -> None:
+    from downstream_perception.cfg import TrackedObstacleLayerConfig
+
+    d = TrackedObstacleLayerConfig.defaults
+    c = dp.PredictionConfig()
+    for name in (
+        "prediction_horizon_s",
+        "uncertainty_sigmas",
+        "max_uncertainty_m",
+        "min_object_size_m",
+        "max_object_size_m",
+        "max_speed_mps",
+    ):
+        assert d[name] == pytest.approx(getattr(c, name)), name
+    assert d["track_timeout_s"] == 1.0 and d["enabled"]
+    assert not d["include_tentative"] and d["include_coasting"]
+    # The obstacle layer's tracked-object clearing is off unless asked for.
+    from downstream_perception.cfg import LogOddsObstacleLayerConfig
+
+    o = LogOddsObstacleLayerConfig.defaults
+    assert o["clear_tracked_objects"] is False
+    assert o["tracked_clearing_margin_m"] == 0.1

@@ -3,7 +3,10 @@
 // message placed with the transform at its own stamp. The master gets LETHAL
 // (l > occupied_log_odds), FREE (l < free_log_odds) or, for cells in between, nothing (they keep
 // what the master holds). Also: footprint clearing, costmap_2d's combination_method, optional
-// time decay of evidence toward unknown, rolling-window shifts, dynamic_reconfigure.
+// time decay of evidence toward unknown, rolling-window shifts, dynamic_reconfigure, and
+// clear_tracked_objects: the evidence under confirmed tracks is forgotten at each update, so a
+// moving object is drawn once, by the TrackedObstacleLayer's prediction, without a trail of its
+// past returns.
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -18,6 +21,7 @@
 #include "downstream_perception/core/log_odds_grid.h"
 #include "downstream_perception/layer.h"
 #include "downstream_perception/layers/observation_source.h"
+#include "downstream_perception/layers/track_inbox.h"
 
 namespace downstream_perception {
 
@@ -26,6 +30,8 @@ struct ObstacleLayerConfig {
   CombinationMethod combination_method = CombinationMethod::kMaximum;  ///< costmap_2d's default
   bool footprint_clearing_enabled = true;
   double decay_time_s = 0.0;  ///< s, time constant of the fade toward unknown; 0 = off
+  bool clear_tracked_objects = false;
+  double tracked_clearing_margin_m = 0.1;  ///< m: growth of each track's box before clearing
 };
 
 class LogOddsObstacleLayer : public Layer {
@@ -54,6 +60,7 @@ class LogOddsObstacleLayer : public Layer {
   void markAllDirty();
   void clearFootprint(double robot_x, double robot_y, double robot_yaw);
   void decay();
+  void clearTrackedObjects();
   void reportError(const std::string& msg);
 
   std::mutex grid_mutex_;  ///< guards grid_, dirty_, evidence_box_
@@ -66,6 +73,10 @@ class LogOddsObstacleLayer : public Layer {
   std::size_t cells_decayed_to_unknown_ = 0;
   std::size_t footprint_cells_cleared_ = 0;
   std::vector<std::size_t> footprint_scratch_;
+  TrackInbox track_inbox_;  ///< confirmed tracks, for clear_tracked_objects
+  ros::Time last_track_clearing_;
+  std::size_t tracked_cells_cleared_ = 0;
+  std::size_t tracks_cleared_last_ = 0;
   bool track_unknown_space_ = true;
   std::vector<std::unique_ptr<ObservationSource>> sources_;
   std::mutex errors_mutex_;

@@ -2,30 +2,31 @@
 // the next prediction_horizon_s, so the inflation layer grows a corridor around each moving
 // object's path and the planner routes around where it is heading, not where it was.
 //
-// Each TrackedObjectArray is released by a tf2 MessageFilter once the transform into the
-// costmap's global frame at the array's own stamp exists, and is transformed with that transform
-// (never "latest"). Each update sweeps every track from its stamp over (now - stamp) +
-// prediction_horizon_s (core/tracking/predicted_footprint.h). A newer array replaces the older;
-// an array older than track_timeout_s is dropped, so a stale track never stays in the map.
+// The tracks come through a TrackInbox (transformed into the costmap's global frame at their own
+// stamp, never "latest"; dropped after track_timeout_s). Each update sweeps every track from its
+// stamp over (now - stamp) + prediction_horizon_s (core/tracking/predicted_footprint.h).
 #pragma once
 
-#include <ros/ros.h>
+#include <dynamic_reconfigure/server.h>
+#include <boost/thread/recursive_mutex.hpp>
 
-#include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
-#include "downstream_perception/TrackedObjectArray.h"
+#include "downstream_perception/TrackedObstacleLayerConfig.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
-#include "downstream_perception/filtered_subscription.h"
 #include "downstream_perception/layer.h"
-#include "downstream_perception/running_stats.h"
+#include "downstream_perception/layers/track_inbox.h"
 
 namespace downstream_perception {
 
 class TrackedObstacleLayer : public Layer {
  public:
+  TrackedObstacleLayer() = default;
+  ~TrackedObstacleLayer() override;
+
   void updateBounds(double robot_x, double robot_y, double robot_yaw, double* min_x, double* min_y,
                     double* max_x, double* max_y) override;
   void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
@@ -39,32 +40,20 @@ class TrackedObstacleLayer : public Layer {
   void onInitialize() override;
 
  private:
-  void onTracks(const TrackedObjectArrayConstPtr& msg);
-  void reject(const std::string& reason, const std::string& detail);
-  void subscribe();
+  using ReconfigureServer = dynamic_reconfigure::Server<TrackedObstacleLayerConfig>;
+  void reconfigure(TrackedObstacleLayerConfig& config, std::uint32_t level);
+  void reportError(const std::string& msg);
 
-  std::mutex mutex_;
-  FilteredSubscription<TrackedObjectArray> subscription_;
-  std::string topic_;
+  TrackInbox inbox_;
+  std::mutex mutex_;  ///< guards everything below
   PredictionConfig prediction_;
-  double track_timeout_s_ = 1.0;
-  bool include_tentative_ = false;
-  bool include_coasting_ = true;
-  int tf_queue_size_ = 20;
-
-  ros::Time tracks_stamp_;           ///< stamp of the array the tracks came from
-  std::vector<PlanarTrack> tracks_;  ///< in the global frame at tracks_stamp_
-  std::vector<std::size_t> cells_;   ///< cells drawn at the last update
+  std::vector<std::size_t> cells_;  ///< cells drawn at the last update
   double drawn_min_x_ = 0.0, drawn_min_y_ = 0.0, drawn_max_x_ = -1.0, drawn_max_y_ = -1.0;
-
-  std::size_t arrays_received_ = 0;
-  std::size_t arrays_expired_ = 0;
-  std::size_t tracks_skipped_state_ = 0;
-  std::map<std::string, std::size_t> rejected_;
-  std::string last_rejection_;
-  RunningStats transform_age_s_;  ///< now - stamp when an array is transformed
   std::size_t tracks_drawn_ = 0;
+  bool subscribed_ = false;
   std::vector<std::string> config_errors_;
+  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  boost::recursive_mutex reconfigure_mutex_;
 };
 
 }  // namespace downstream_perception

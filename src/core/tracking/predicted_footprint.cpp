@@ -173,4 +173,23 @@ CellBounds predictedCells(const PlanarTrack& track, double age_s, const Predicti
   return bounds;
 }
 
+CellBounds recentCells(const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
+                       double max_object_size_m, const GridGeometry& geometry,
+                       std::vector<std::size_t>* cells) {
+  const auto bad = [](double v) { return !(std::isfinite(v) && v >= 0.0); };
+  if (bad(lookback_s) || bad(age_s) || bad(margin_m) || bad(max_object_size_m)) return {};
+  // The same sweep as a prediction, started lookback_s earlier, with the box grown and no
+  // uncertainty: only where the object has been, not where it may go.
+  PlanarTrack earlier = track;
+  earlier.position = predictPosition(track, -lookback_s);
+  earlier.size_x = std::min(track.size_x, max_object_size_m) + 2.0 * margin_m;
+  earlier.size_y = std::min(track.size_y, max_object_size_m) + 2.0 * margin_m;
+  PredictionConfig sweep;
+  sweep.prediction_horizon_s = 0.0;
+  sweep.uncertainty_sigmas = 0.0;
+  sweep.max_object_size_m = max_object_size_m + 2.0 * margin_m;
+  sweep.max_speed_mps = std::numeric_limits<double>::infinity();
+  return predictedCells(earlier, lookback_s + age_s, sweep, geometry, cells);
+}
+
 }  // namespace downstream_perception

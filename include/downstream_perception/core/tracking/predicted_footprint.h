@@ -64,4 +64,13 @@ Footprint sweptPolygon(const PlanarTrack& track, double duration_s, const Predic
 CellBounds predictedCells(const PlanarTrack& track, double age_s, const PredictionConfig& config,
                           const GridGeometry& geometry, std::vector<std::size_t>* cells);
 
+/// Cells under the track's box, each side grown by margin_m (sides clamped to max_object_size_m),
+/// swept from lookback_s before its stamp to age_s after it: where the object's own sensor returns
+/// have recently landed and where it is now. The obstacle layer clears these cells
+/// (clear_tracked_objects) so that a tracked object is drawn once, by its prediction. Appends to
+/// *cells like predictedCells().
+CellBounds recentCells(const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
+                       double max_object_size_m, const GridGeometry& geometry,
+                       std::vector<std::size_t>* cells);
+
 }  // namespace downstream_perception
