@@ -1,5 +1,7 @@
 #include "downstream_perception/layers/laser_scan_source.h"
 
+#include "downstream_perception/message_checks.h"
+
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 
@@ -59,23 +61,14 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
     reject("bad message: zero stamp", "a scan must carry its measurement time");
     return;
   }
-  LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
-                     msg->angle_increment, msg->range_min,     msg->range_max};
-  std::string why = view.validate();
-  if (why.empty() && std::isfinite(msg->angle_max)) {
-    const double expected = (msg->angle_max - msg->angle_min) / msg->angle_increment + 1.0;
-    if (std::abs(expected - static_cast<double>(msg->ranges.size())) > 1.5) {
-      std::ostringstream s;
-      s << msg->ranges.size() << " ranges but angle_min/max/increment imply " << expected;
-      why = s.str();
-    }
-  }
-  if (why.empty() && !std::isfinite(msg->time_increment)) why = "time_increment is not finite";
+  const std::string why = checkScan(*msg);
   if (!why.empty()) {
     reject("bad message: inconsistent scan", why);
     return;
   }
 
+  LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
+                     msg->angle_increment, msg->range_min,     msg->range_max};
   const std::string& frame = frameOf(msg->header.frame_id);
   Pose2D first;
   bool upside_down = false;

@@ -1,8 +1,8 @@
 #include "downstream_perception/layers/point_cloud_source.h"
 
-#include <Eigen/Geometry>
+#include "downstream_perception/message_checks.h"
 
-#include <sstream>
+#include <Eigen/Geometry>
 
 namespace downstream_perception {
 
@@ -22,40 +22,6 @@ void PointCloudSource::subscribe() {
       });
 }
 
-std::string PointCloudSource::checkLayout(const sensor_msgs::PointCloud2& msg,
-                                          std::size_t* x_offset) {
-  const auto field = [&msg](const char* name) -> const sensor_msgs::PointField* {
-    for (const auto& f : msg.fields) {
-      if (f.name == name) return &f;
-    }
-    return nullptr;
-  };
-  const sensor_msgs::PointField* x = field("x");
-  const sensor_msgs::PointField* y = field("y");
-  const sensor_msgs::PointField* z = field("z");
-  std::ostringstream why;
-  if (x == nullptr || y == nullptr || z == nullptr) {
-    why << "no x, y and z fields";
-  } else if (x->datatype != sensor_msgs::PointField::FLOAT32 ||
-             y->datatype != sensor_msgs::PointField::FLOAT32 ||
-             z->datatype != sensor_msgs::PointField::FLOAT32 || y->offset != x->offset + 4 ||
-             z->offset != x->offset + 8) {
-    why << "x, y, z must be consecutive FLOAT32 fields";
-  } else if (msg.is_bigendian) {
-    why << "big-endian clouds are not supported";
-  } else if (msg.point_step < x->offset + 12) {
-    why << "point_step " << msg.point_step << " is smaller than the x, y, z fields";
-  } else if (static_cast<std::uint64_t>(msg.width) * msg.point_step > msg.row_step) {
-    why << "row_step " << msg.row_step << " < width * point_step";
-  } else if (static_cast<std::uint64_t>(msg.row_step) * msg.height != msg.data.size()) {
-    why << "data holds " << msg.data.size()
-        << " bytes, row_step * height = " << static_cast<std::uint64_t>(msg.row_step) * msg.height;
-  } else {
-    *x_offset = x->offset;
-  }
-  return why.str();
-}
-
 void PointCloudSource::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   countReceived();
   if (msg->header.stamp.isZero()) {
@@ -63,7 +29,7 @@ void PointCloudSource::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     return;
   }
   std::size_t x_offset = 0;
-  const std::string why = checkLayout(*msg, &x_offset);
+  const std::string why = checkCloudLayout(*msg, &x_offset);
   if (!why.empty()) {
     reject("bad message: cloud layout", why);
     return;

@@ -4,66 +4,58 @@
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>  // PoseStamped in tf2_ros::Buffer::transform
 
 #include <cmath>
-#include <sstream>
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/se2.h"
-#include "downstream_perception/tf_failure.h"
-#include "downstream_perception/track_transform.h"
+#include "downstream_perception/message_checks.h"
 
 namespace downstream_perception {
 
 HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_, nh), diagnostics_(nh, pnh) {
+    : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_, nh), diagnostics_(nh, pnh, pnh.getNamespace()) {
   loadParameters();
   correction_ = CorrectionMonitor(correction_config_);
   health_.map_odom_pose_age_s = -1.0;  // no report yet
-  std::vector<std::string> scan_topics, track_topics;
-  pnh_.param("scan_topics", scan_topics, std::vector<std::string>{});
-  pnh_.param("track_topics", track_topics, std::vector<std::string>{});
-  for (const std::string& topic : scan_topics) {
-    Input* input = &addInput(topic, "LaserScan");
-    input->scans.subscribe(
-        nh_, topic, tf_buffer_, planning_frame_, 20,
-        [this, input](const sensor_msgs::LaserScanConstPtr& m) {
-          recordArrival(input, m->header.stamp);
-        },
-        [this, input](const sensor_msgs::LaserScanConstPtr& m,
-                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-          onTfFailure(input, m->header.frame_id, m->header.stamp, reason);
-        });
+  RelayTopics topics;
+  pnh_.param("scan_topics", topics.scans, topics.scans);
+  pnh_.param("cloud_topics", topics.clouds, topics.clouds);
+  pnh_.param("track_topics", topics.tracks, topics.tracks);
+  pnh_.param("republish", topics.republish, topics.republish);
+  pnh_.param("tf_queue_size", topics.tf_queue_size, topics.tf_queue_size);
+  if (topics.tf_queue_size < 1 || topics.tf_queue_size > 10000) {
+    configError("parameter tf_queue_size = " + toText(topics.tf_queue_size) +
+                " must be in [1, 10000]; using 20");
+    topics.tf_queue_size = 20;
   }
-  for (const std::string& topic : track_topics) {
-    Input* input = &addInput(topic, "TrackedObjectArray");
-    input->tracks.subscribe(
-        nh_, topic, tf_buffer_, planning_frame_, 20,
-        [this, input](const TrackedObjectArrayConstPtr& m) { onTracks(input, m); },
-        [this, input](const TrackedObjectArrayConstPtr& m,
-                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-          onTfFailure(input, m->header.frame_id, m->header.stamp, reason);
-        });
-  }
+  relay_ = std::make_unique<PlanningFrameRelay>(nh_, pnh_, tf_buffer_, planning_frame_, topics);
   goal_publisher_ = pnh_.advertise<geometry_msgs::PoseStamped>("goal_base", 10);
-  tracks_publisher_ = pnh_.advertise<TrackedObjectArray>("tracks_planning", 10);
   health_publisher_ = pnh_.advertise<SeamHealth>("seam_health", 1);
   goal_subscriber_ = nh_.subscribe("goal", 10, &HandoffRos::onGoal, this);
   transform_service_ = pnh_.advertiseService("transform_pose", &HandoffRos::onTransformPose, this);
   diagnostics_.setHardwareID("handoff");
   diagnostics_.add("seam", this, &HandoffRos::diagnose);
+  // The server reads the YAML values (or the .cfg defaults, equal to SeamLimits') and calls
+  // reconfigure() at once: one code path for start-up and live changes.
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
+  reconfigure_server_->setCallback(boost::bind(&HandoffRos::reconfigure, this,
+                                               boost::placeholders::_1, boost::placeholders::_2));
   timer_ = nh_.createTimer(ros::Duration(1.0 / health_rate_hz_), &HandoffRos::onTimer, this);
-  ROS_INFO("handoff: planning in '%s', goals to '%s', %zu scan and %zu track inputs",
-           planning_frame_.c_str(), robot_base_frame_.c_str(), scan_topics.size(),
-           track_topics.size());
+  ROS_INFO("handoff: planning in '%s', goals to '%s', %zu scan, %zu cloud and %zu track inputs%s",
+           planning_frame_.c_str(), robot_base_frame_.c_str(), topics.scans.size(),
+           topics.clouds.size(), topics.tracks.size(),
+           topics.republish ? " re-published in the planning frame" : "");
+}
+
+void HandoffRos::configError(const std::string& msg) {
+  ROS_ERROR("handoff: %s", msg.c_str());
+  std::lock_guard<std::mutex> lock(mutex_);
+  config_errors_.push_back(msg);
 }
 
 void HandoffRos::loadParameters() {
   pnh_.param("planning_frame", planning_frame_, planning_frame_);
   pnh_.param("odom_frame", odom_frame_, odom_frame_);
   pnh_.param("robot_base_frame", robot_base_frame_, robot_base_frame_);
-  pnh_.param("reference_range_m", reference_range_m_, reference_range_m_);
-  pnh_.param("max_transform_age_s", max_transform_age_s_, max_transform_age_s_);
-  pnh_.param("max_smear_m", max_smear_m_, max_smear_m_);
-  pnh_.param("max_map_odom_age_s", max_map_odom_age_s_, max_map_odom_age_s_);
   pnh_.param("health_rate_hz", health_rate_hz_, health_rate_hz_);
   pnh_.param("correction_window_s", correction_config_.window_s, correction_config_.window_s);
   pnh_.param("correction_reset_drop_m", correction_config_.reset_drop_m,
@@ -72,66 +64,38 @@ void HandoffRos::loadParameters() {
              correction_config_.max_correction_m);
   pnh_.param("correction_min_travel_m", correction_config_.min_travel_m,
              correction_config_.min_travel_m);
-  const auto positive = [this](const char* name, double* value, double fallback) {
-    if (std::isfinite(*value) && *value > 0.0) return;
-    config_errors_.push_back(std::string("parameter ") + name + " = " + toText(*value) +
-                             " must be > 0; using " + toText(fallback));
-    ROS_ERROR("handoff: %s", config_errors_.back().c_str());
-    *value = fallback;
-  };
-  positive("reference_range_m", &reference_range_m_, 5.0);
-  positive("max_transform_age_s", &max_transform_age_s_, 0.1);
-  positive("max_smear_m", &max_smear_m_, 0.05);
-  positive("max_map_odom_age_s", &max_map_odom_age_s_, 2.0);
-  positive("health_rate_hz", &health_rate_hz_, 2.0);
+  if (!(std::isfinite(health_rate_hz_) && health_rate_hz_ > 0.0 && health_rate_hz_ <= 1000.0)) {
+    configError("parameter health_rate_hz = " + toText(health_rate_hz_) +
+                " must be in (0, 1000] Hz; using 2.0");
+    health_rate_hz_ = 2.0;
+  }
   const std::string why = correction_config_.validate();
   if (!why.empty()) {
-    config_errors_.push_back(why + "; using the defaults");
-    ROS_ERROR("handoff: %s", config_errors_.back().c_str());
+    configError(why + "; using the defaults");
     correction_config_ = CorrectionMonitorConfig();
   }
 }
 
-HandoffRos::Input& HandoffRos::addInput(const std::string& topic, const std::string& type) {
-  inputs_.push_back(std::make_unique<Input>());
-  inputs_.back()->topic = ros::names::resolve(topic);
-  inputs_.back()->type = type;
-  return *inputs_.back();
-}
-
-void HandoffRos::recordArrival(Input* input, const ros::Time& stamp) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  input->ages.add((ros::Time::now() - stamp).toSec());
-}
-
-void HandoffRos::onTfFailure(Input* input, const std::string& frame, const ros::Time& stamp,
-                             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+void HandoffRos::reconfigure(HandoffConfig& cfg, std::uint32_t) {
+  SeamLimits limits;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++input->tf_failures;
+    limits = limits_;
   }
-  ROS_WARN_THROTTLE(2.0, "handoff: %s on %s ('%s' at %f) not placed in '%s': %s",
-                    input->type.c_str(), input->topic.c_str(), frame.c_str(), stamp.toSec(),
-                    planning_frame_.c_str(), tfFailureReason(reason));
-}
-
-void HandoffRos::onTracks(Input* input, const TrackedObjectArrayConstPtr& msg) {
-  recordArrival(input, msg->header.stamp);
-  geometry_msgs::TransformStamped t;
-  try {
-    // Released by the MessageFilter: the transform at the stamp exists.
-    t = tf_buffer_.lookupTransform(planning_frame_, msg->header.frame_id, msg->header.stamp);
-  } catch (const tf2::TransformException&) {
-    onTfFailure(input, msg->header.frame_id, msg->header.stamp,
-                tf2_ros::filter_failure_reasons::Unknown);
-    return;
-  }
-  TrackedObjectArray out;
-  out.header = msg->header;
-  out.header.frame_id = planning_frame_;  // the stamp stays the measurement's
-  out.tracks.reserve(msg->tracks.size());
-  for (const TrackedObject& o : msg->tracks) out.tracks.push_back(transformTrack(o, t));
-  tracks_publisher_.publish(out);
+  const auto set = [this](const char* name, double value, double* target) {
+    if (std::isfinite(value) && value > 0.0) {
+      *target = value;
+      return;
+    }
+    configError(std::string("parameter ") + name + " = " + toText(value) +
+                " must be > 0; keeping " + toText(*target));
+  };
+  set("reference_range_m", cfg.reference_range_m, &limits.reference_range_m);
+  set("max_transform_age_s", cfg.max_transform_age_s, &limits.max_transform_age_s);
+  set("max_smear_m", cfg.max_smear_m, &limits.max_smear_m);
+  set("max_map_odom_age_s", cfg.max_map_odom_age_s, &limits.max_map_odom_age_s);
+  std::lock_guard<std::mutex> lock(mutex_);
+  limits_ = limits;
 }
 
 bool HandoffRos::transformPose(const geometry_msgs::PoseStamped& in,
@@ -150,13 +114,14 @@ bool HandoffRos::transformPose(const geometry_msgs::PoseStamped& in,
 }
 
 void HandoffRos::onGoal(const geometry_msgs::PoseStampedConstPtr& msg) {
+  const std::string bad = checkPose(*msg);
   geometry_msgs::PoseStamped out;
   std::string why;
-  if (!transformPose(*msg, robot_base_frame_, &out, &why)) {
+  if (!bad.empty() || !transformPose(*msg, robot_base_frame_, &out, &why)) {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++goal_failures_;
-    last_goal_failure_ = why;
-    ROS_WARN_THROTTLE(2.0, "handoff: goal dropped: %s", why.c_str());
+    ++(bad.empty() ? goal_failures_ : goals_rejected_);
+    last_goal_failure_ = bad.empty() ? why : "bad goal: " + bad;
+    ROS_WARN_THROTTLE(2.0, "handoff: goal dropped: %s", last_goal_failure_.c_str());
     return;
   }
   {
@@ -167,8 +132,8 @@ void HandoffRos::onGoal(const geometry_msgs::PoseStampedConstPtr& msg) {
 }
 
 bool HandoffRos::onTransformPose(TransformPose::Request& req, TransformPose::Response& res) {
-  std::string why;
-  res.success = transformPose(req.pose, req.target_frame, &res.pose, &why);
+  std::string why = checkPose(req.pose);
+  res.success = why.empty() && transformPose(req.pose, req.target_frame, &res.pose, &why);
   res.message = res.success ? "ok" : why;
   return true;
 }
@@ -179,10 +144,15 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
   bool have_rate = false;
   try {
     const auto b = tf_buffer_.lookupTransform(odom_frame_, robot_base_frame_, ros::Time(0));
-    const auto a = tf_buffer_.lookupTransform(odom_frame_, robot_base_frame_,
-                                              b.header.stamp - ros::Duration(0.1));
+    // A static odom <- base_link comes back stamped 0: a robot that cannot turn.
+    const bool moving = b.header.stamp.toSec() > 0.1;
+    const auto a = moving ? tf_buffer_.lookupTransform(odom_frame_, robot_base_frame_,
+                                                       b.header.stamp - ros::Duration(0.1))
+                          : b;
     const double dt = (b.header.stamp - a.header.stamp).toSec();
-    if (dt > 0.0) {
+    if (!moving) {
+      have_rate = true;
+    } else if (dt > 0.0) {
       yaw_rate = shortestAngularDistance(tf2::getYaw(a.transform.rotation),
                                          tf2::getYaw(b.transform.rotation)) /
                  dt;
@@ -202,13 +172,14 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
     have_correction = true;
   } catch (const tf2::TransformException&) {
   }
+  std::vector<SeamInput> inputs = relay_->inputs();
   const ros::Time now = ros::Time::now();
   SeamHealth health;
   health.header.stamp = now;
   health.header.frame_id = planning_frame_;
-  health.reference_range_m = reference_range_m_;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    health.reference_range_m = limits_.reference_range_m;
     if (have_rate) yaw_rate_rps_ = yaw_rate;
     health.yaw_rate_rps = yaw_rate_rps_;
     if (have_correction) {
@@ -219,7 +190,7 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
       health.map_odom_pose_age_s =
           map_odom.header.stamp.isZero() ? -1.0 : (now - map_odom.header.stamp).toSec();
       correction_.add(now.toSec(), health.map_odom_correction_m, travelled_m_);
-      if (health.map_odom_pose_age_s > max_map_odom_age_s_) {
+      if (health.map_odom_pose_age_s > limits_.max_map_odom_age_s) {
         health.warnings.push_back("map<-odom is " + toText(health.map_odom_pose_age_s) +
                                   " s old (localisation stopped?)");
       }
@@ -229,24 +200,17 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
       health.warnings.push_back("no transform '" + planning_frame_ + "' <- '" + odom_frame_ + "'");
     }
     health.map_odom_resets = static_cast<std::uint32_t>(correction_.resets());
-    for (const auto& input : inputs_) {
-      SeamInput in;
-      in.topic = input->topic;
-      in.type = input->type;
-      in.messages = input->ages.total();
-      in.tf_failures = input->tf_failures;
-      in.transform_age_p50_s = input->ages.percentile(0.5);
-      in.transform_age_p95_s = input->ages.percentile(0.95);
-      in.transform_age_max_s = input->ages.percentile(1.0);
+    for (SeamInput& in : inputs) {
       in.expected_smear_m =
-          expectedSmear(reference_range_m_, yaw_rate_rps_, in.transform_age_p95_s);
-      if (in.transform_age_p95_s > max_transform_age_s_) {
+          expectedSmear(limits_.reference_range_m, yaw_rate_rps_, in.transform_age_p95_s);
+      if (in.transform_age_p95_s > limits_.max_transform_age_s) {
         health.warnings.push_back(in.topic + ": transform age p95 " +
                                   toText(in.transform_age_p95_s) + " s > max_transform_age_s");
       }
-      if (in.expected_smear_m > max_smear_m_) {
+      if (in.expected_smear_m > limits_.max_smear_m) {
         health.warnings.push_back(in.topic + ": expected smear " + toText(in.expected_smear_m) +
-                                  " m at " + toText(reference_range_m_) + " m > max_smear_m");
+                                  " m at " + toText(limits_.reference_range_m) +
+                                  " m > max_smear_m");
       }
       health.inputs.push_back(in);
     }
@@ -264,6 +228,7 @@ void HandoffRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   for (const SeamInput& in : health_.inputs) {
     status.add(in.topic + " messages", in.messages);
     status.add(in.topic + " tf failures", in.tf_failures);
+    status.add(in.topic + " rejected (malformed)", in.rejected);
     status.add(in.topic + " transform age p50 (s)", in.transform_age_p50_s);
     status.add(in.topic + " transform age p95 (s)", in.transform_age_p95_s);
     status.add(in.topic + " expected smear at reference range (m)", in.expected_smear_m);
@@ -274,6 +239,7 @@ void HandoffRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("map<-odom resets", health_.map_odom_resets);
   status.add("goals handed down", goals_);
   status.add("goals dropped (no transform at stamp)", goal_failures_);
+  status.add("goals rejected (bad pose)", goals_rejected_);
   if (!last_goal_failure_.empty()) status.add("last goal failure", last_goal_failure_);
   addConfigErrors(status, config_errors_);
   if (!config_errors_.empty()) {

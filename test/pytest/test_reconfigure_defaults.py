@@ -96,3 +96,22 @@ def test_tracked_obstacle_layer_defaults_match_prediction_config() -> None:
     o = LogOddsObstacleLayerConfig.defaults
     assert o["clear_tracked_objects"] is False
     assert o["tracked_clearing_margin_m"] == 0.1
+
+
+def test_handoff_defaults_match_yaml() -> None:
+    from pathlib import Path
+
+    import yaml
+
+    from downstream_perception.cfg import HandoffConfig
+
+    d = HandoffConfig.defaults
+    documented = yaml.safe_load((Path(__file__).parents[2] / "cfg" / "handoff.yaml").read_text())
+    assert set(d) == {
+        "reference_range_m",
+        "max_transform_age_s",
+        "max_smear_m",
+        "max_map_odom_age_s",
+    }
+    for name, value in d.items():
+        assert documented[name] == pytest.approx(value), name

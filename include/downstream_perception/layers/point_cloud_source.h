@@ -20,9 +20,6 @@ class PointCloudSource : public ObservationSource {
   void unsubscribe() override { subscription_.unsubscribe(); }
   const char* dataType() const override { return "PointCloud2"; }
 
-  /// Empty if the cloud's layout is usable, else the reason; sets the byte offset of x.
-  static std::string checkLayout(const sensor_msgs::PointCloud2& msg, std::size_t* x_offset);
-
  private:
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
 
