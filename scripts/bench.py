@@ -15,6 +15,7 @@ import subprocess
 import time
 from pathlib import Path
 
+import bench_latency  # scripts/bench_latency.py, next to this file
 import bench_tsdf  # scripts/bench_tsdf.py, next to this file
 import numpy as np
 
@@ -142,6 +143,7 @@ def main() -> None:
     binding = python_binding_overhead()
     sim = simulator_speed()
     tsdf = bench_tsdf.run()
+    latency = bench_latency.run()
 
     lines = [
         "# downstream_perception benchmark",
@@ -255,6 +257,7 @@ def main() -> None:
         ),
         "",
         *bench_tsdf.markdown(tsdf),
+        *bench_latency.markdown(latency),
         "## Python side",
         "",
         f"- one 360-beam scan through the pybind11 binding (200^2): median "
@@ -276,6 +279,7 @@ def main() -> None:
                 "decay": decay,
                 "tracker": tracker,
                 "tsdf": tsdf,
+                "latency": latency,
                 "binding": binding,
                 "sim": sim,
             },
