@@ -230,8 +230,8 @@ def markdown(r: dict[str, Any]) -> list[str]:
         f"Scans at {SCAN_HZ:.0f} Hz, detections at {DETECTION_HZ:.0f} Hz for "
         f"{r['duration_s']:.0f} s; the costmap (obstacle layer with tracked-object clearing, "
         "tracked-obstacle layer, inflation) updates and publishes at 10 Hz, so up to 100 ms "
-        "of each figure is the wait for the next update and the next publish. Measured at the subscriber: receive time of "
-        "the first costmap message showing it, minus the message's stamp.",
+        "of each figure is the wait for the next update and the next publish. Measured at the "
+        "subscriber: receive time of the first costmap message showing it, minus the stamp.",
         "",
         "| from | samples | p50 (ms) | p99 (ms) | max (ms) |",
         "|---|---|---|---|---|",
