@@ -15,35 +15,9 @@ import rospy
 import tf2_ros
 from std_msgs.msg import Bool
 
-from downstream_perception.msg import DetectedObject, DetectedObjectArray
-from downstream_perception.ros_util import transform_stamped
+from downstream_perception.msg import DetectedObjectArray
+from downstream_perception.ros_util import detection_array, transform_stamped
 from downstream_perception.sim import ObjectScene, SceneConfig
-
-
-def detection_array(
-    stamp: rospy.Time,
-    frame: str,
-    positions: np.ndarray,
-    scores: np.ndarray,
-    truth: np.ndarray,
-    variance: float,
-) -> DetectedObjectArray:
-    msg = DetectedObjectArray()
-    msg.header.stamp = stamp
-    msg.header.frame_id = frame
-    for (x, y), score, truth_id in zip(positions, scores, truth, strict=True):
-        d = DetectedObject()
-        d.header = msg.header
-        d.kind = DetectedObject.POSITION
-        d.class_id = 0
-        d.label = "object"
-        d.score = float(score)
-        d.position.x, d.position.y = float(x), float(y)
-        d.position_covariance = [variance, 0.0, 0.0, variance]
-        d.size_x = d.size_y = 0.5
-        d.truth_id = int(truth_id)
-        msg.detections.append(d)
-    return msg
 
 
 def main() -> None:

@@ -4,7 +4,10 @@
 Publishes sensor_msgs/LaserScan on `scan` (frame `laser`, stamped with the measurement time),
 tf map->odom (a drifting "localizer" correction) and odom->base_link at ~tf_rate_hz, a static
 base_link->laser, and std_msgs/Bool(True) on latched `sim_done` when the trajectory has ended (tf
-and scans go on from the final pose). Parameters: see README ("Simulator node").
+and scans go on from the final pose). With ~detection_rate_hz > 0 it also plays an object
+detector: the world's moving objects within ~detection_range_m on `detections`
+(DetectedObjectArray in base_link, Gaussian position noise, sizes, labels, truth ids).
+Parameters: see README ("Simulator node").
 """
 
 from __future__ import annotations
@@ -18,8 +21,9 @@ from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
 
-from downstream_perception.ros_util import laser_scan, transform_stamped
-from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive
+from downstream_perception.msg import DetectedObjectArray
+from downstream_perception.ros_util import detection_array, laser_scan, transform_stamped
+from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive, stand
 
 
 def se2_matrix(x: float, y: float, yaw: float) -> np.ndarray:
@@ -51,9 +55,19 @@ class SimNode:
         if not math.isfinite(speed) or speed <= 0.0:
             rospy.logerr("sim: ~speed_mps must be positive, got %s; using 1.0", speed)
             speed = 1.0
-        self.trajectory = aisle_drive(speed)
+        if str(p("~trajectory", "aisle_drive")) == "stand":
+            duration = float(p("~duration_s", 20.0))
+            if not math.isfinite(duration) or duration <= 0.0:
+                rospy.logerr("sim: ~duration_s must be positive, got %s; using 20", duration)
+                duration = 20.0
+            self.trajectory = stand(float(p("~stand_x", 2.0)), float(p("~stand_y", 0.0)), duration)
+        else:
+            self.trajectory = aisle_drive(speed)
         self.scan_rate = max(0.1, float(p("~scan_rate_hz", 10.0)))
-        self.tf_rate = max(self.scan_rate, float(p("~tf_rate_hz", 50.0)))
+        self.detection_rate = max(0.0, float(p("~detection_rate_hz", 0.0)))
+        self.detection_noise = max(0.0, float(p("~detection_noise_m", 0.03)))
+        self.detection_range = float(p("~detection_range_m", 15.0))
+        self.tf_rate = max(self.scan_rate, self.detection_rate, float(p("~tf_rate_hz", 50.0)))
         self.lidar = Lidar(
             LidarConfig(
                 num_beams=int(p("~num_beams", 360)),
@@ -81,6 +95,9 @@ class SimNode:
         self.odom_map = np.linalg.inv(self.map_odom)
 
         self.scan_pub = rospy.Publisher("scan", LaserScan, queue_size=10)
+        self.detection_pub = rospy.Publisher("detections", DetectedObjectArray, queue_size=10)
+        self.rng = np.random.default_rng(int(p("~seed", 0)) + 1)
+        self.class_ids: dict[str, int] = {}  # one class id per label, in order of appearance
         self.done_pub = rospy.Publisher("sim_done", Bool, queue_size=1, latch=True)
         self.tf = tf2_ros.TransformBroadcaster()
         self.static_tf = tf2_ros.StaticTransformBroadcaster()
@@ -97,6 +114,9 @@ class SimNode:
         self.done = False
         self.ticks = 0
         self.scan_every = max(1, round(self.tf_rate / self.scan_rate))
+        self.detect_every = (
+            max(1, round(self.tf_rate / self.detection_rate)) if self.detection_rate > 0 else 0
+        )
 
     def sim_time(self, stamp: rospy.Time) -> float:
         t = max(0.0, (stamp - self.start).to_sec() - self.start_delay)
@@ -118,6 +138,8 @@ class SimNode:
         )
         if self.ticks % self.scan_every == 0:
             self.publish_scan(stamp, t, map_base)
+        if self.detect_every and self.ticks % self.detect_every == 0:
+            self.publish_detections(stamp, t, map_base)
         self.ticks += 1
         if not self.done and not self.loop and t >= self.trajectory.duration:
             self.done = True
@@ -140,6 +162,28 @@ class SimNode:
         )
         msg.scan_time = 1.0 / self.scan_rate
         self.scan_pub.publish(msg)
+
+    def publish_detections(self, stamp: rospy.Time, t: float, map_base: np.ndarray) -> None:
+        objects = self.world.objects_at(t)
+        base_map = np.linalg.inv(map_base)
+        xy = np.array([[o.x, o.y, 1.0] for o in objects]).reshape(-1, 3)
+        in_base = (base_map @ xy.T).T[:, :2]
+        near = np.hypot(in_base[:, 0], in_base[:, 1]) <= self.detection_range
+        noisy = in_base + self.rng.normal(0.0, self.detection_noise, in_base.shape)
+        kept = [o for o, k in zip(objects, near, strict=True) if k]
+        self.detection_pub.publish(
+            detection_array(
+                stamp,
+                self.frames["base"],
+                noisy[near],
+                np.full(len(kept), 0.9),
+                np.array([o.truth_id for o in kept]),
+                max(self.detection_noise**2, 1e-6),
+                sizes=np.array([[o.size_x, o.size_y] for o in kept]).reshape(-1, 2),
+                labels=[o.label for o in kept],
+                class_ids=[self.class_ids.setdefault(o.label, len(self.class_ids)) for o in kept],
+            )
+        )
 
 
 def main() -> None:

@@ -5,6 +5,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <geometry_msgs/PolygonStamped.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
@@ -56,6 +57,7 @@ class CostmapRos {
   std::unique_ptr<LayeredCostmap> layered_costmap_;
   std::unique_ptr<CostmapPublisher> publisher_;
   ros::Publisher footprint_publisher_;
+  geometry_msgs::PolygonStamped footprint_msg_;  ///< the padded footprint in robot_base_frame
   ros::ServiceServer clear_service_;
   diagnostic_updater::Updater diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import rospy
@@ -86,6 +87,47 @@ def transform_from_matrix(
     r = t.transform.rotation
     r.w, r.x, r.y, r.z = (float(c) for c in q)
     return t
+
+
+def detection_array(
+    stamp: rospy.Time,
+    frame: str,
+    positions: np.ndarray,
+    scores: np.ndarray,
+    truth: np.ndarray,
+    variance: float,
+    sizes: np.ndarray | None = None,
+    labels: list[str] | None = None,
+    class_ids: list[int] | None = None,
+) -> Any:
+    """A DetectedObjectArray of POSITION detections: positions (N, 2) m in `frame`, scores,
+    truth ids (-1 = clutter), isotropic position variance (m^2), sizes (N, 2) m (default 0.5 m
+    squares), labels (default "object") and class ids (default 0; the tracker keeps one label
+    per class id)."""
+    from downstream_perception.msg import DetectedObject, DetectedObjectArray
+
+    msg = DetectedObjectArray()
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame
+    n = len(positions)
+    sizes = np.full((n, 2), 0.5) if sizes is None else np.asarray(sizes, dtype=float)
+    labels = ["object"] * n if labels is None else labels
+    class_ids = [0] * n if class_ids is None else class_ids
+    for (x, y), score, truth_id, (sx, sy), label, class_id in zip(
+        positions, scores, truth, sizes, labels, class_ids, strict=True
+    ):
+        d = DetectedObject()
+        d.header = msg.header
+        d.kind = DetectedObject.POSITION
+        d.class_id = int(class_id)
+        d.label = label
+        d.score = float(score)
+        d.position.x, d.position.y = float(x), float(y)
+        d.position_covariance = [variance, 0.0, 0.0, variance]
+        d.size_x, d.size_y = float(sx), float(sy)
+        d.truth_id = int(truth_id)
+        msg.detections.append(d)
+    return msg
 
 
 def wait_until(predicate: Callable[[], bool], timeout_s: float = 15.0) -> bool:

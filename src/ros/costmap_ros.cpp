@@ -65,17 +65,18 @@ void CostmapRos::applyFootprint() {
   std::vector<std::string> errors;
   layered_costmap_->setFootprint(readFootprint(pnh_, &errors));
   for (const auto& e : errors) reportError(e);
-  // Latched, in the robot frame: rviz draws it wherever the robot is.
-  geometry_msgs::PolygonStamped msg;
-  msg.header.frame_id = config_.robot_base_frame;
-  msg.header.stamp = ros::Time::now();
+  // Latched, in the robot frame, stamp 0: the shape holds at every time, so rviz draws it
+  // wherever the robot is now (a start-up stamp would predate the robot's first tf). Sent again
+  // with every costmap publish: a viewer whose tf was not ready for the first one catches up.
+  footprint_msg_ = geometry_msgs::PolygonStamped();
+  footprint_msg_.header.frame_id = config_.robot_base_frame;
   for (const FootprintPoint& p : layered_costmap_->footprint()) {
     geometry_msgs::Point32 q;
     q.x = static_cast<float>(p.x);
     q.y = static_cast<float>(p.y);
-    msg.polygon.points.push_back(q);
+    footprint_msg_.polygon.points.push_back(q);
   }
-  footprint_publisher_.publish(msg);
+  footprint_publisher_.publish(footprint_msg_);
 }
 
 void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
@@ -241,6 +242,7 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
     publisher_->publish(layered_costmap_->costmap(), now, unpublished_);
     unpublished_ = CellBounds{};
     last_publish_ = now;
+    footprint_publisher_.publish(footprint_msg_);
   }
   diagnostics_.update();
 }

@@ -134,3 +134,26 @@ def test_many_beams_vectorised() -> None:
     doorway = 2 * math.atan(0.5 / 15.0)
     expected = 1.0 - (open_end + doorway) / (2 * math.pi)
     assert np.isfinite(ranges).mean() == pytest.approx(expected, abs=0.002)
+
+
+def test_moving_box_is_hit_where_it_is_and_reported_with_its_size() -> None:
+    from downstream_perception.sim import MovingBox, aisle_traffic, stand
+
+    box = MovingBox(0.6, 0.4, np.array([[0.0, 10.0, 0.0], [10.0, 0.0, 0.0]]))  # -1 m/s along x
+    world = World(boxes=[box], labels=["forklift"])
+    # At t = 4 s its centre is at x = 6: the near face at 5.4, seen from the origin along +x.
+    assert cast(world, (0.0, 0.0), 0.0, t=4.0) == pytest.approx(5.4)
+    assert math.isinf(cast(world, (0.0, 0.0), 0.0, t=11.0))  # gone after its path
+    (seen,) = world.objects_at(4.0)
+    assert (seen.label, seen.x, seen.y, seen.size_x, seen.size_y) == pytest.approx(
+        ("forklift", 6.0, 0.0, 1.2, 0.8)
+    )
+    assert world.objects_at(11.0) == []
+
+    traffic = aisle_traffic()
+    labels = sorted(o.label for o in traffic.objects_at(5.0))
+    assert labels == ["forklift", "person", "person"]
+    # The robot's stand-still trajectory keeps its pose.
+    assert stand(2.0, 0.0, 10.0).pose(5.0) == pytest.approx((2.0, 0.0, 0.0))
+    with pytest.raises(ValueError):
+        stand(2.0, 0.0, 0.0)

@@ -50,3 +50,10 @@ def aisle_drive(speed_mps: float = 1.0) -> Trajectory:
     if speed_mps <= 0.0:
         raise ValueError("speed_mps must be positive")
     return Trajectory(np.array([[0.0, 1.0, 0.0], [17.0 / speed_mps, 18.0, 0.0]]))
+
+
+def stand(x: float, y: float, duration_s: float) -> Trajectory:
+    """Standing still at (x, y), facing +x, for duration_s."""
+    if not duration_s > 0.0:
+        raise ValueError("duration_s must be positive")
+    return Trajectory(np.array([[0.0, x, y], [duration_s, x, y]]))

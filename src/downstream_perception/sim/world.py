@@ -43,10 +43,57 @@ def box_segments(cx: float, cy: float, half_x: float, half_y: float) -> np.ndarr
 
 
 @dataclass
+class MovingBox:
+    """An axis-aligned box (a forklift, a cart) moving along a piecewise-linear path; absent
+    outside the path's times."""
+
+    half_x: float
+    half_y: float
+    waypoints: np.ndarray  # (P, 3) rows (t_s, x, y), t increasing
+
+    def position(self, t: float) -> tuple[float, float] | None:
+        return MovingCircle(0.0, self.waypoints).position(t)
+
+
+@dataclass
+class SeenObject:
+    """What an ideal detector reports of a mover at one instant (world frame)."""
+
+    truth_id: int
+    label: str
+    x: float
+    y: float
+    size_x: float
+    size_y: float
+
+
+@dataclass
 class World:
     segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # (M, 4) x0 y0 x1 y1
     circles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (K, 3) cx cy r
     movers: list[MovingCircle] = field(default_factory=list)
+    boxes: list[MovingBox] = field(default_factory=list)
+    labels: list[str] = field(default_factory=list)  # per mover, then per box; default "object"
+
+    def segments_at(self, t: float) -> np.ndarray:
+        """Static segments plus the edges of the moving boxes present at time t, (M', 4)."""
+        present = [box_segments(*p, b.half_x, b.half_y) for b in self.boxes if (p := b.position(t))]
+        return np.vstack([self.segments, *present]) if present else self.segments
+
+    def objects_at(self, t: float) -> list[SeenObject]:
+        """Every mover and moving box present at time t; truth ids count movers, then boxes."""
+        seen = []
+        for k, m in enumerate([*self.movers, *self.boxes]):
+            p = m.position(t)
+            if p is None:
+                continue
+            label = self.labels[k] if k < len(self.labels) else "object"
+            if isinstance(m, MovingCircle):
+                size_x = size_y = 2.0 * m.radius
+            else:
+                size_x, size_y = 2.0 * m.half_x, 2.0 * m.half_y
+            seen.append(SeenObject(k, label, p[0], p[1], size_x, size_y))
+        return seen
 
     def circles_at(self, t: float) -> np.ndarray:
         """Static circles plus the movers present at time t, (K', 3)."""
@@ -65,8 +112,9 @@ class World:
         dy = np.sin(angles)[:, None]
         best = np.full(angles.shape, np.inf)
         with np.errstate(divide="ignore", invalid="ignore"):
-            if len(self.segments):
-                s = self.segments
+            segments = self.segments_at(t)
+            if len(segments):
+                s = segments
                 ex = (s[:, 2] - s[:, 0])[None, :]
                 ey = (s[:, 3] - s[:, 1])[None, :]
                 wx = (s[:, 0] - ox)[None, :]
@@ -137,9 +185,43 @@ def warehouse_aisle() -> World:
     )
 
 
+def aisle_traffic() -> World:
+    """The warehouse aisle (without its crossing person) with traffic for the handoff demo: a
+    forklift (1.2 m x 0.8 m) driving down the aisle towards x = 0 at 0.7 m/s, one person crossing
+    the aisle back and forth at x = 11, another walking up the aisle at 1 m/s. A robot standing
+    at x = 2 faces them all."""
+    aisle = warehouse_aisle()
+    forklift = MovingBox(0.6, 0.4, np.array([[0.0, 17.5, -0.7], [20.0, 3.5, -0.7]]))
+    crossing = MovingCircle(
+        PERSON_RADIUS_M,
+        np.array(
+            [
+                [0.0, 11.0, 1.2],
+                [4.8, 11.0, -1.2],
+                [9.6, 11.0, 1.2],
+                [14.4, 11.0, -1.2],
+                [19.2, 11.0, 1.2],
+                [24.0, 11.0, -1.2],
+            ]
+        ),
+    )
+    walking = MovingCircle(PERSON_RADIUS_M, np.array([[0.0, 4.5, 0.6], [12.0, 16.5, 0.6]]))
+    return World(
+        segments=aisle.segments,
+        circles=aisle.circles,
+        movers=[crossing, walking],
+        boxes=[forklift],
+        labels=["person", "person", "forklift"],
+    )
+
+
 def open_field() -> World:
     """Nothing at all: every beam is a no-return (+inf)."""
     return World()
 
 
-WORLDS = {"warehouse_aisle": warehouse_aisle, "open_field": open_field}
+WORLDS = {
+    "warehouse_aisle": warehouse_aisle,
+    "aisle_traffic": aisle_traffic,
+    "open_field": open_field,
+}
