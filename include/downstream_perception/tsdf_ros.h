@@ -2,10 +2,12 @@
 // stamp in a fixed world frame (a tf2 MessageFilter holds a message until its transform exists);
 // the mesh out as per-block rviz markers and a height-band slice (OccupancyGrid, for the
 // TsdfLayer and rviz) at ~mesh_rate_hz; services to save the mesh and clear
-// the map; diagnostics. The nodelet and the node are thin shells around it.
+// the map; diagnostics; the settings that keep the voxel lattice live through
+// dynamic_reconfigure. The nodelet and the node are thin shells around it.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -17,6 +19,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <Eigen/Geometry>
+#include <boost/thread/recursive_mutex.hpp>
 
 #include <map>
 #include <memory>
@@ -25,6 +28,7 @@
 #include <vector>
 
 #include "downstream_perception/SaveMap.h"
+#include "downstream_perception/TsdfNodeletConfig.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
@@ -73,6 +77,8 @@ class TsdfRos {
   bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);
   bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void reconfigure(TsdfNodeletConfig& config, std::uint32_t level);
+  void configError(const std::string& msg);
   void reject(const std::string& reason, const std::string& detail);
   void account(const TsdfIntegrationStats& stats, double elapsed_ms);
 
@@ -101,6 +107,7 @@ class TsdfRos {
   std::size_t octree_occupied_ = 0;
   RunningStats octree_ms_;
   TsdfSliceConfig slice_;
+  bool slice_changed_ = false;  ///< the band moved: re-slice at the next mesh tick
   TsdfSliceStats slice_stats_;
   ros::ServiceServer save_service_;
   ros::ServiceServer clear_service_;
@@ -121,6 +128,11 @@ class TsdfRos {
   ros::Time last_health_;
   TsdfHealth health_;
   std::vector<std::string> config_errors_;
+
+  using ReconfigureServer = dynamic_reconfigure::Server<TsdfNodeletConfig>;
+  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  boost::recursive_mutex reconfigure_mutex_;
+  bool reconfigure_started_ = false;
 };
 
 }  // namespace downstream_perception

@@ -197,6 +197,16 @@ void bindTsdf(py::module& m) {
            py::arg("config") = TsdfConfig{})
       .def_property_readonly("config", [](const Tsdf& t) { return t.map.config(); })
       .def(
+          "set_config",
+          [](Tsdf& self, const TsdfConfig& c) {
+            const std::string why = self.map.setConfig(c);
+            if (!why.empty()) throw std::invalid_argument(why);
+          },
+          py::arg("config"),
+          "Replaces the settings that keep the voxel lattice (weights, depth limits, edge guard, "
+          "memory bounds); raises ValueError for an invalid config or another voxel_size_m or "
+          "truncation_voxels.")
+      .def(
           "integrate_depth",
           [](Tsdf& self, const py::array& depth, const PinholeCamera& camera,
              const Eigen::Matrix4d& T_map_camera) {

@@ -188,6 +188,9 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   cloud_filter_ = tfFilter<sensor_msgs::PointCloud2>(&TsdfRos::onCloud, "point cloud", queue);
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
   mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
+  reconfigure_server_->setCallback(
+      boost::bind(&TsdfRos::reconfigure, this, boost::placeholders::_1, boost::placeholders::_2));
   const TsdfConfig& c = map_->config();
   ROS_INFO("tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s",
            c.voxel_size_m, c.truncation(), world_frame_.c_str(),
@@ -196,11 +199,75 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 TsdfRos::~TsdfRos() {
+  reconfigure_server_.reset();
   mesh_timer_.stop();
   depth_subscriber_.shutdown();
   cloud_subscriber_.shutdown();
   depth_filter_.reset();
   cloud_filter_.reset();
+}
+
+void TsdfRos::configError(const std::string& msg) {
+  ROS_ERROR("tsdf: %s", msg.c_str());
+  std::lock_guard<std::mutex> lock(mutex_);
+  config_errors_.push_back(msg);
+}
+
+void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
+  if (!reconfigure_started_) {
+    // The first call carries the parameter server's values, already read (and reported if
+    // invalid) by the constructor: nothing to apply.
+    reconfigure_started_ = true;
+    return;
+  }
+  TsdfConfig next;
+  TsdfSliceConfig slice;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    next = map_->config();
+    slice = slice_;
+  }
+  next.max_weight = cfg.max_weight;
+  next.behind_surface_dropoff = cfg.behind_surface_dropoff;
+  next.edge_guard_rad = cfg.edge_guard_rad;
+  next.interpolate_depth = cfg.interpolate_depth;
+  next.min_depth_m = cfg.min_depth_m;
+  next.max_depth_m = cfg.max_depth_m;
+  next.min_weight = cfg.min_weight;
+  next.max_block_distance_m = cfg.max_block_distance_m;
+  std::string why;
+  if (cfg.max_blocks < 1) {
+    why = "max_blocks must be >= 1, got " + std::to_string(cfg.max_blocks);
+  } else if (cfg.weighting != "constant" && cfg.weighting != "inverse_square_depth") {
+    why = "weighting must be 'constant' or 'inverse_square_depth', got '" + cfg.weighting + "'";
+  }
+  next.max_blocks = static_cast<std::size_t>(std::max(1, cfg.max_blocks));
+  next.weighting = cfg.weighting == "inverse_square_depth"
+                       ? TsdfConfig::Weighting::kInverseSquareDepth
+                       : TsdfConfig::Weighting::kConstant;
+  TsdfSliceConfig next_slice = slice;
+  next_slice.min_z_m = cfg.slice_min_z_m;
+  next_slice.max_z_m = cfg.slice_max_z_m;
+  const std::string slice_why = next_slice.validate();
+  TsdfConfig now;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (why.empty()) why = map_->setConfig(next);
+    if (slice_why.empty()) {
+      slice_changed_ = slice_changed_ || next_slice.min_z_m != slice_.min_z_m ||
+                       next_slice.max_z_m != slice_.max_z_m;
+      slice_ = next_slice;
+    }
+    now = map_->config();
+    slice = slice_;
+  }
+  if (!why.empty()) configError("live TSDF parameters refused (" + why + "); keeping the previous");
+  if (!slice_why.empty()) {
+    configError("live slice band refused (" + slice_why + "); keeping [" + toText(slice.min_z_m) +
+                ", " + toText(slice.max_z_m) + "] m");
+  }
+  ROS_INFO("tsdf: live settings: max weight %.1f, depth [%.2f, %.2f] m, slice [%.2f, %.2f] m",
+           now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m);
 }
 
 void TsdfRos::reject(const std::string& reason, const std::string& detail) {
@@ -374,7 +441,10 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
     header.frame_id = world_frame_;
     header.stamp = ros::Time::now();
     markers = markers_.changed(mesher_, header);
-    if (!mesher_.lastUpdated().empty() || !markers.markers.empty()) slice = makeSlice(header);
+    if (!mesher_.lastUpdated().empty() || !markers.markers.empty() || slice_changed_) {
+      slice = makeSlice(header);
+      slice_changed_ = false;
+    }
     if (octree_ && octree_changed_) {
       occupied = occupiedCloud(header);
       octree_changed_ = false;
@@ -501,6 +571,10 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("blocks evicted by distance (total)", blocks_evicted_);
   status.add("mesh triangles", mesh_triangles_);
   status.add("slice: occupied cells", slice_stats_.cells_occupied);
+  status.add("slice band (m)", toText(slice_.min_z_m) + " .. " + toText(slice_.max_z_m));
+  status.add("max_weight", map_->config().max_weight);
+  status.add("depth range (m)",
+             toText(map_->config().min_depth_m) + " .. " + toText(map_->config().max_depth_m));
   if (octree_) {
     status.add("octomap: leaves", octree_->leafCount());
     status.add("octomap: occupied leaves", octree_occupied_);

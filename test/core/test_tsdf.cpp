@@ -151,6 +151,29 @@ TEST(Tsdf, MaxWeightKeepsTheMapResponsive) {
   EXPECT_GT(distanceAt(map, 5), 0.1f);  // 5 is now in front of the surface
 }
 
+TEST(Tsdf, LiveSettingsChangeButTheLatticeDoesNot) {
+  TsdfConfig c = lessonConfig();
+  c.max_weight = 0.0;
+  TsdfMap map(c);
+  for (int k = 0; k < 5; ++k) integratePoints(&map, {Eigen::Vector3d(4.5, 0, 0)}, {0, 0, 0});
+  EXPECT_FLOAT_EQ(map.voxel({5, 0, 0})->weight, 5.0f);
+  // A cap set live applies to the next fusion.
+  TsdfConfig capped = map.config();
+  capped.max_weight = 3.0;
+  EXPECT_EQ(map.setConfig(capped), "");
+  integratePoints(&map, {Eigen::Vector3d(4.5, 0, 0)}, {0, 0, 0});
+  EXPECT_FLOAT_EQ(map.voxel({5, 0, 0})->weight, 3.0f);
+  // The lattice is fixed, and an invalid config changes nothing.
+  TsdfConfig other = map.config();
+  other.voxel_size_m *= 2.0;
+  EXPECT_NE(map.setConfig(other).find("fixed"), std::string::npos);
+  other = map.config();
+  other.min_depth_m = other.max_depth_m + 1.0;
+  EXPECT_FALSE(map.setConfig(other).empty());
+  EXPECT_EQ(map.config().max_weight, 3.0);
+  EXPECT_EQ(map.config().min_depth_m, capped.min_depth_m);
+}
+
 TEST(Tsdf, DepthImageOfAFrontoParallelPlaneMeshesAtItsDepth) {
   TsdfConfig c;
   c.voxel_size_m = 0.05;

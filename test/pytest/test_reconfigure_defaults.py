@@ -115,3 +115,32 @@ def test_handoff_defaults_match_yaml() -> None:
     }
     for name, value in d.items():
         assert documented[name] == pytest.approx(value), name
+
+
+def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
+    from pathlib import Path
+
+    import yaml
+
+    from downstream_perception.cfg import TsdfNodeletConfig
+
+    d = TsdfNodeletConfig.defaults
+    c = dp.TsdfConfig()
+    for name in (
+        "max_weight",
+        "behind_surface_dropoff",
+        "edge_guard_rad",
+        "interpolate_depth",
+        "min_depth_m",
+        "max_depth_m",
+        "min_weight",
+        "max_blocks",
+        "max_block_distance_m",
+    ):
+        assert d[name] == pytest.approx(getattr(c, name)), name
+    assert d["weighting"] == "constant"
+    assert (d["slice_min_z_m"], d["slice_max_z_m"]) == (0.05, 1.8)
+    documented = yaml.safe_load((Path(__file__).parents[2] / "cfg" / "tsdf.yaml").read_text())
+    for name, value in d.items():
+        if name in documented:
+            assert documented[name] == pytest.approx(value) or documented[name] == value, name

@@ -40,6 +40,24 @@ def test_lesson_fusion_table() -> None:
     np.testing.assert_array_equal(weight, 2.0)
 
 
+def test_live_settings_apply_and_the_lattice_is_fixed() -> None:
+    tsdf = lesson_tsdf()
+    points = np.array([[4.5, 0.0, 0.0]])
+    for _ in range(4):
+        tsdf.integrate_points(points, np.zeros(3))
+    capped = tsdf.config
+    capped.max_weight = 2.0
+    tsdf.set_config(capped)
+    tsdf.integrate_points(points, np.zeros(3))
+    _, weight = tsdf.sample(np.array([[5.0, 0.0, 0.0]]))
+    assert weight[0] == 2.0  # 4 + 1 fused, then capped by the live setting
+    coarser = tsdf.config
+    coarser.voxel_size_m = 2.0
+    with pytest.raises(ValueError, match="fixed"):
+        tsdf.set_config(coarser)
+    assert tsdf.config.voxel_size_m == 1.0
+
+
 def camera(c: DepthCamera) -> dp.PinholeCamera:
     return dp.PinholeCamera(c.fx, c.fy, c.cx, c.cy, c.width, c.height)
 

@@ -18,6 +18,8 @@ import numpy as np
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
+from dynamic_reconfigure.client import Client as ReconfigureClient
+from nav_msgs.msg import OccupancyGrid
 from sensor_msgs import point_cloud2
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Bool, Header
@@ -63,6 +65,12 @@ class TsdfRoomTest(unittest.TestCase):
         def on_octomap(msg: PointCloud2) -> None:
             cls.octomap = msg
 
+        cls.slice: OccupancyGrid | None = None
+
+        def on_slice(msg: OccupancyGrid) -> None:
+            cls.slice = msg
+
+        rospy.Subscriber("/tsdf/slice", OccupancyGrid, on_slice, queue_size=1)
         rospy.Subscriber("/tsdf/mesh", MarkerArray, on_mesh, queue_size=20)
         rospy.Subscriber("/tsdf/octomap_occupied", PointCloud2, on_octomap, queue_size=1)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
@@ -111,6 +119,55 @@ class TsdfRoomTest(unittest.TestCase):
         self.assertTrue(reply.success, reply.message)
         with open(path, "rb") as f:
             self.assertTrue(f.readline().startswith(b"# Octomap OcTree binary file"))
+
+    def occupied_xy(self, band_bottom: float) -> np.ndarray:
+        """Centres (x, y) of the occupied cells of the first slice whose band starts at
+        band_bottom (the grid's origin z)."""
+        self.assertTrue(
+            wait_until(
+                lambda: self.slice is not None
+                and abs(self.slice.info.origin.position.z - band_bottom) < 1e-6,
+                10.0,
+            ),
+            f"no slice with its band at {band_bottom} m",
+        )
+        msg = self.slice
+        info = msg.info
+        grid = np.asarray(msg.data, dtype=np.int8).reshape(info.height, info.width)
+        rows, cols = np.nonzero(grid == 100)
+        x = info.origin.position.x + (cols + 0.5) * info.resolution
+        y = info.origin.position.y + (rows + 0.5) * info.resolution
+        return np.c_[x, y]
+
+    def test_2c_slice_band_changes_live(self) -> None:
+        self.assertTrue(wait_until(lambda: self.done, 60.0), "the depth simulator never finished")
+
+        def near(xy: np.ndarray, cx: float, cy: float, half_x: float, half_y: float) -> int:
+            return int(((np.abs(xy[:, 0] - cx) < half_x) & (np.abs(xy[:, 1] - cy) < half_y)).sum())
+
+        # The box (top at 0.70 m) and the table top (0.72-0.76 m) are in the default band...
+        default = self.occupied_xy(0.05)
+        self.assertGreater(near(default, 0.8, 0.6, 0.35, 0.3), 5, "the box is not in the slice")
+        self.assertGreater(near(default, -0.8, 0.7, 0.45, 0.35), 5, "the table is not in it")
+        # ... and a band above them, set live, leaves both out (the sphere, pole, walls remain).
+        client = ReconfigureClient("/tsdf", timeout=10.0)
+        client.update_configuration({"slice_min_z_m": 0.85, "slice_max_z_m": 0.95})
+        high = self.occupied_xy(0.85)
+        self.assertGreater(len(high), 20)
+        self.assertEqual(near(high, 0.8, 0.6, 0.35, 0.3), 0, "the box is still in the slice")
+        self.assertEqual(near(high, -0.8, 0.7, 0.45, 0.35), 0, "the table is still in it")
+        # An inverted band is refused, counted, and the live band kept.
+        errors = int(self.status.get("config errors", 0))
+        client.update_configuration({"slice_min_z_m": 1.0, "slice_max_z_m": 0.5})
+        self.assertTrue(
+            wait_until(lambda: int(self.status.get("config errors", 0)) > errors, 10.0),
+            f"diagnostics: {self.status}",
+        )
+        self.assertEqual(self.status["slice band (m)"], "0.85 .. 0.95")
+        client.update_configuration({"slice_min_z_m": 0.05, "slice_max_z_m": 1.8})
+        self.assertTrue(
+            wait_until(lambda: self.status.get("slice band (m)") == "0.05 .. 1.8", 10.0)
+        )
 
     def test_3_bad_frames_are_counted_and_survived(self) -> None:
         images = rospy.Publisher("/depth/image", Image, queue_size=50)

@@ -36,6 +36,19 @@ TsdfMap::TsdfMap(const TsdfConfig& config) : config_(config) {
   max_weight_ = static_cast<float>(config.max_weight);
 }
 
+std::string TsdfMap::setConfig(const TsdfConfig& config) {
+  std::string why = config.validate();
+  if (!why.empty()) return why;
+  if (config.voxel_size_m != config_.voxel_size_m ||
+      config.truncation_voxels != config_.truncation_voxels) {
+    return "voxel_size_m and truncation_voxels are fixed for the map's life (the stored distances "
+           "are in their units); restart the node to change them";
+  }
+  config_ = config;
+  max_weight_ = static_cast<float>(config.max_weight);
+  return {};
+}
+
 namespace {
 int floorDiv(int a, int b) {
   return a >= 0 ? a / b : -((-a + b - 1) / b);

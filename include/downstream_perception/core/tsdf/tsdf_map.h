@@ -89,6 +89,11 @@ class TsdfMap {
   explicit TsdfMap(const TsdfConfig& config = {});
 
   const TsdfConfig& config() const { return config_; }
+  /// Replaces the settings that do not define the voxel lattice (weights, depth limits,
+  /// edge guard, memory bounds). Empty on success; else the reason, and nothing changes: an
+  /// invalid config, or one with another voxel_size_m or truncation_voxels (those are fixed for
+  /// the map's life: the stored distances are in their units).
+  std::string setConfig(const TsdfConfig& config);
   double voxelSize() const { return config_.voxel_size_m; }
 
   /// Block containing voxel `voxel`, and the voxel's index inside it.
