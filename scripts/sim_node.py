@@ -22,13 +22,9 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
 
 from downstream_perception.msg import DetectedObjectArray
+from downstream_perception.planar import se2_matrix
 from downstream_perception.ros_util import detection_array, laser_scan, transform_stamped
 from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive, stand
-
-
-def se2_matrix(x: float, y: float, yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, x], [s, c, y], [0.0, 0.0, 1.0]])
 
 
 def to_transform(

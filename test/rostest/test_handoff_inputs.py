@@ -26,6 +26,7 @@ from std_msgs.msg import Header
 from tf2_ros import StaticTransformBroadcaster
 
 from downstream_perception.msg import SeamHealth
+from downstream_perception.planar import se2_matrix
 from downstream_perception.ros_util import laser_scan, transform_stamped, wait_until
 from downstream_perception.srv import TransformPose
 
@@ -34,12 +35,7 @@ ODOM_BASE = (3.0, 0.0, math.radians(30))
 BASE_LASER = (0.1, 0.0, 0.0)  # and 0.2 m up
 
 
-def se2(x: float, y: float, yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, x], [s, c, y], [0.0, 0.0, 1.0]])
-
-
-MAP_LASER = se2(*MAP_ODOM) @ se2(*ODOM_BASE) @ se2(*BASE_LASER)
+MAP_LASER = se2_matrix(*MAP_ODOM) @ se2_matrix(*ODOM_BASE) @ se2_matrix(*BASE_LASER)
 
 
 class HandoffInputsTest(unittest.TestCase):

@@ -10,7 +10,6 @@ draws nothing behind the cart and the 1 s predicted sweep ahead of it. Both keep
 
 from __future__ import annotations
 
-import math
 import threading
 import unittest
 
@@ -23,6 +22,7 @@ from tf2_ros import StaticTransformBroadcaster
 
 from downstream_perception.costmap_client import CostmapClient
 from downstream_perception.msg import DetectedObject, DetectedObjectArray
+from downstream_perception.planar import se2_matrix
 from downstream_perception.ros_util import laser_scan, transform_stamped, wait_until
 from downstream_perception.sim import Lidar, LidarConfig
 from downstream_perception.sim.world import MovingCircle, World
@@ -35,12 +35,7 @@ ORIGIN, RES = (-2.0, -5.0), 0.05
 WALL_REGION_X = 5.7  # cells beyond this belong to the wall
 
 
-def se2(x: float, y: float, yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, x], [s, c, y], [0.0, 0.0, 1.0]])
-
-
-MAP_BASE = se2(*MAP_ODOM) @ se2(*ODOM_BASE)
+MAP_BASE = se2_matrix(*MAP_ODOM) @ se2_matrix(*ODOM_BASE)
 BASE_MAP = np.linalg.inv(MAP_BASE)
 
 

@@ -20,6 +20,7 @@ from tf2_ros import StaticTransformBroadcaster
 
 from downstream_perception.costmap_client import CostmapClient
 from downstream_perception.msg import DetectedObject, DetectedObjectArray, TrackedObjectArray
+from downstream_perception.planar import se2_matrix
 from downstream_perception.ros_util import transform_stamped, wait_until
 
 SPEED = -0.6  # m/s along map x
@@ -30,12 +31,7 @@ MAP_ODOM = (2.0, 1.0, math.radians(10))
 ODOM_BASE = (3.0, 0.0, math.radians(30))
 
 
-def se2(x: float, y: float, yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, x], [s, c, y], [0.0, 0.0, 1.0]])
-
-
-BASE_FROM_MAP = np.linalg.inv(se2(*MAP_ODOM) @ se2(*ODOM_BASE))
+BASE_FROM_MAP = np.linalg.inv(se2_matrix(*MAP_ODOM) @ se2_matrix(*ODOM_BASE))
 
 
 class TrackedObstaclesTest(unittest.TestCase):
