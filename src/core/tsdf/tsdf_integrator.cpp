@@ -36,9 +36,11 @@ float observationWeight(const TsdfConfig& c, float z, float sdf, float mu) {
 Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
   // Voxel = round(p / s); block = floor(voxel / 8), computed on doubles.
   const Eigen::Vector3d q = p * inv_voxel + Eigen::Vector3d::Constant(0.5);
-  return {static_cast<int>(std::floor(std::floor(q.x()) / kTsdfBlockSide)),
-          static_cast<int>(std::floor(std::floor(q.y()) / kTsdfBlockSide)),
-          static_cast<int>(std::floor(std::floor(q.z()) / kTsdfBlockSide))};
+  // floor(floor(q) / 8) = floor(q / 8), and dividing by 8 is exact in binary floating point.
+  constexpr double kInvSide = 1.0 / kTsdfBlockSide;
+  return {static_cast<int>(std::floor(q.x() * kInvSide)),
+          static_cast<int>(std::floor(q.y() * kInvSide)),
+          static_cast<int>(std::floor(q.z() * kInvSide))};
 }
 
 // A depth image checked once per frame: depth (m; NaN invalid, +Inf no return) and inverse
@@ -51,6 +53,10 @@ struct DepthFrame {
   /// Pixels within edge_guard_rad of a depth edge (a jump of more than mu between neighbours, or
   /// an invalid neighbour): what lies behind them is not known to be behind a surface.
   std::vector<std::uint8_t> near_edge;
+  /// 1 where the 2 x 2 pixels from this one (right, down) are all valid depths within a voxel
+  /// of each other: inverse depth may be interpolated between them. Checked once per pixel here
+  /// instead of once per voxel in the integration loop (empty without interpolate_depth).
+  std::vector<std::uint8_t> smooth;
   float min_depth = std::numeric_limits<float>::infinity();
 };
 
@@ -95,22 +101,46 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
       f.inverse[i] = 0.0f;
     }
   }
+  if (c.interpolate_depth) {
+    const int w = camera.width, h = camera.height;
+    const float max_step = static_cast<float>(c.voxel_size_m);
+    f.smooth.assign(n, 0);
+    for (int v = 0; v + 1 < h; ++v) {
+      for (int u = 0; u + 1 < w; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        const float* inv = f.inverse.data() + i;
+        if (inv[0] == 0.0f || inv[1] == 0.0f || inv[w] == 0.0f || inv[w + 1] == 0.0f) continue;
+        const float* d = f.depth.data() + i;
+        const float lo = std::min(std::min(d[0], d[1]), std::min(d[w], d[w + 1]));
+        const float hi = std::max(std::max(d[0], d[1]), std::max(d[w], d[w + 1]));
+        f.smooth[i] = hi - lo <= max_step;
+      }
+    }
+  }
   const int radius =
       static_cast<int>(std::ceil(c.edge_guard_rad * std::max(camera.fx, camera.fy) - 1e-9));
   if (radius > 0) {
     const int w = camera.width, h = camera.height;
     std::vector<std::uint8_t> edge(n, 0);
     const float jump = static_cast<float>(c.truncation());
+    const float* inv = f.inverse.data();
+    const float* dep = f.depth.data();
+    const auto differs = [&](std::size_t j, float d) {
+      return inv[j] == 0.0f || std::abs(dep[j] - d) > jump;
+    };
     for (int v = 0; v < h; ++v) {
+      const bool inner_row = v > 0 && v + 1 < h;
       for (int u = 0; u < w; ++u) {
         const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        if (f.inverse[i] == 0.0f) continue;
-        const float d = f.depth[i];
-        const auto differs = [&](std::size_t j) {
-          return f.inverse[j] == 0.0f || std::abs(f.depth[j] - d) > jump;
-        };
-        edge[i] = (u + 1 < w && differs(i + 1)) || (u > 0 && differs(i - 1)) ||
-                  (v + 1 < h && differs(i + w)) || (v > 0 && differs(i - w));
+        if (inv[i] == 0.0f) continue;
+        const float d = dep[i];
+        if (inner_row && u > 0 && u + 1 < w) {
+          // No bounds to check: all four neighbours at once, without branches between them.
+          edge[i] = differs(i + 1, d) | differs(i - 1, d) | differs(i + w, d) | differs(i - w, d);
+        } else {
+          edge[i] = (u + 1 < w && differs(i + 1, d)) || (u > 0 && differs(i - 1, d)) ||
+                    (v + 1 < h && differs(i + w, d)) || (v > 0 && differs(i - w, d));
+        }
       }
     }
     // Dilate by `radius` (separable box: rows, then columns).
@@ -146,24 +176,18 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
 
 /// Depth at a sub-pixel position: inverse depth interpolated bilinearly between the four
 /// surrounding pixel centres (exact on planes, where 1/z is affine in the image), or `nearest`
-/// when a neighbour is not a valid depth or the four differ by more than `max_step` (a depth
-/// edge: interpolating there would put surface in free space).
-float interpolatedDepth(const DepthFrame& f, int w, int h, float uf, float vf, float nearest,
-                        float max_step) {
+/// when a neighbour is not a valid depth or the four differ by more than the voxel size (a depth
+/// edge: interpolating there would put surface in free space; DepthFrame::smooth).
+float interpolatedDepth(const DepthFrame& f, int w, float uf, float vf, float nearest) {
   if (uf < 0.0f || vf < 0.0f) return nearest;
   const int u0 = static_cast<int>(uf);
   const int v0 = static_cast<int>(vf);
-  if (u0 + 1 >= w || v0 + 1 >= h) return nearest;
   const std::size_t i = static_cast<std::size_t>(v0) * w + u0;
+  if (!f.smooth[i]) return nearest;  // also 0 in the last row and column
   const float* inv = f.inverse.data() + i;
-  const float i00 = inv[0], i10 = inv[1], i01 = inv[w], i11 = inv[w + 1];
-  if (i00 == 0.0f || i10 == 0.0f || i01 == 0.0f || i11 == 0.0f) return nearest;
-  const float* d = f.depth.data() + i;
-  const float lo = std::min(std::min(d[0], d[1]), std::min(d[w], d[w + 1]));
-  const float hi = std::max(std::max(d[0], d[1]), std::max(d[w], d[w + 1]));
-  if (hi - lo > max_step) return nearest;
   const float a = uf - static_cast<float>(u0), b = vf - static_cast<float>(v0);
-  return 1.0f / ((1.0f - b) * ((1.0f - a) * i00 + a * i10) + b * ((1.0f - a) * i01 + a * i11));
+  return 1.0f / ((1.0f - b) * ((1.0f - a) * inv[0] + a * inv[1]) +
+                 b * ((1.0f - a) * inv[w] + a * inv[w + 1]));
 }
 
 /// Blocks the truncation band of the valid pixels passes through. Pixels are sampled every
@@ -246,6 +270,7 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   const float min_z = static_cast<float>(c.min_depth_m), max_z = static_cast<float>(c.max_depth_m);
   const float muf = static_cast<float>(mu), sf = static_cast<float>(s);
   const float u_end = static_cast<float>(w), v_end = static_cast<float>(h);
+  const bool interpolate = c.interpolate_depth;
   for (const Eigen::Vector3i& key : keys) {
     const bool existed = map->find(key) != nullptr;
     TsdfBlock* block = map->allocate(key);
@@ -270,7 +295,8 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
           // centre (no half-pixel bias).
           const float us = fx * p.x() * inv_z + cx;
           const float vs = fy * p.y() * inv_z + cy;
-          if (!(us >= 0.0f && vs >= 0.0f && us < u_end && vs < v_end)) continue;
+          // Inside the image: four compares combined without branches between them.
+          if (!((us >= 0.0f) & (vs >= 0.0f) & (us < u_end) & (vs < v_end))) continue;
           const std::size_t pixel = static_cast<std::size_t>(vs) * w + static_cast<std::size_t>(us);
           const float nearest = frame.depth[pixel];
           float sdf;
@@ -285,9 +311,9 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
             if (along_axis > muf + max_step) {
               sdf = muf;
             } else {
-              const float d = c.interpolate_depth ? interpolatedDepth(frame, w, h, us - 0.5f,
-                                                                      vs - 0.5f, nearest, max_step)
-                                                  : nearest;
+              const float d = interpolate
+                                  ? interpolatedDepth(frame, w, us - 0.5f, vs - 0.5f, nearest)
+                                  : nearest;
               sdf = (d - zc) * frame.range_per_depth[pixel];
               if (sdf < -muf) continue;
               // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".

@@ -33,7 +33,8 @@ std::string TsdfConfig::validate() const {
 TsdfMap::TsdfMap(const TsdfConfig& config) : config_(config) {
   const std::string why = config.validate();
   if (!why.empty()) throw std::invalid_argument("tsdf: " + why);
-  max_weight_ = static_cast<float>(config.max_weight);
+  weight_cap_ = config.max_weight > 0.0 ? static_cast<float>(config.max_weight)
+                                        : std::numeric_limits<float>::infinity();
 }
 
 std::string TsdfMap::setConfig(const TsdfConfig& config) {
@@ -45,7 +46,8 @@ std::string TsdfMap::setConfig(const TsdfConfig& config) {
            "are in their units); restart the node to change them";
   }
   config_ = config;
-  max_weight_ = static_cast<float>(config.max_weight);
+  weight_cap_ = config.max_weight > 0.0 ? static_cast<float>(config.max_weight)
+                                        : std::numeric_limits<float>::infinity();
   return {};
 }
 

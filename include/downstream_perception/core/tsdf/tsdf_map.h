@@ -11,9 +11,11 @@
 #include <tsl/robin_map.h>
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -116,7 +118,7 @@ class TsdfMap {
   void fuse(TsdfVoxel* v, float d, float w) const {
     const float total = v->weight + w;
     v->distance = (v->weight * v->distance + w * d) / total;
-    v->weight = max_weight_ > 0.0f && total > max_weight_ ? max_weight_ : total;
+    v->weight = std::min(total, weight_cap_);
   }
 
   /// Removes blocks whose centre is farther than `distance_m` from `center`; returns how many.
@@ -135,7 +137,7 @@ class TsdfMap {
 
  private:
   TsdfConfig config_;
-  float max_weight_ = 0.0f;
+  float weight_cap_ = std::numeric_limits<float>::infinity();  ///< max_weight, or none (0)
   BlockMap blocks_;
   std::uint64_t generation_ = 0;
 };
