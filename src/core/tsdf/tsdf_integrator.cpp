@@ -25,13 +25,26 @@ std::string PinholeCamera::validate() const {
 namespace {
 
 /// Observation weight of a depth z (m) for the configured weighting, with the behind-surface
-/// drop-off applied to sdf (m).
-float observationWeight(const TsdfConfig& c, float z, float sdf, float mu) {
-  float w = c.weighting == TsdfConfig::Weighting::kInverseSquareDepth ? 1.0f / (z * z) : 1.0f;
-  const float s = static_cast<float>(c.voxel_size_m);
-  if (c.behind_surface_dropoff && sdf < -s) w *= (mu + sdf) / (mu - s);
-  return w;
-}
+/// drop-off applied to sdf (m). The settings are read once per frame, not once per voxel.
+class ObservationWeight {
+ public:
+  ObservationWeight(const TsdfConfig& c, float mu)
+      : inverse_square_(c.weighting == TsdfConfig::Weighting::kInverseSquareDepth),
+        dropoff_(c.behind_surface_dropoff),
+        s_(static_cast<float>(c.voxel_size_m)),
+        mu_(mu) {}
+  float operator()(float z, float sdf) const {
+    float w = inverse_square_ ? 1.0f / (z * z) : 1.0f;
+    if (dropoff_ && sdf < -s_) w *= (mu_ + sdf) / (mu_ - s_);
+    return w;
+  }
+
+ private:
+  bool inverse_square_;
+  bool dropoff_;
+  float s_;
+  float mu_;
+};
 
 Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
   // Voxel = round(p / s); block = floor(voxel / 8), computed on doubles.
@@ -109,11 +122,11 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
       for (int u = 0; u + 1 < w; ++u) {
         const std::size_t i = static_cast<std::size_t>(v) * w + u;
         const float* inv = f.inverse.data() + i;
-        if (inv[0] == 0.0f || inv[1] == 0.0f || inv[w] == 0.0f || inv[w + 1] == 0.0f) continue;
         const float* d = f.depth.data() + i;
         const float lo = std::min(std::min(d[0], d[1]), std::min(d[w], d[w + 1]));
         const float hi = std::max(std::max(d[0], d[1]), std::max(d[w], d[w + 1]));
-        f.smooth[i] = hi - lo <= max_step;
+        f.smooth[i] = (inv[0] != 0.0f) & (inv[1] != 0.0f) & (inv[w] != 0.0f) &
+                      (inv[w + 1] != 0.0f) & (hi - lo <= max_step);
       }
     }
   }
@@ -125,49 +138,47 @@ DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfCo
     const float jump = static_cast<float>(c.truncation());
     const float* inv = f.inverse.data();
     const float* dep = f.depth.data();
-    const auto differs = [&](std::size_t j, float d) {
-      return inv[j] == 0.0f || std::abs(dep[j] - d) > jump;
-    };
+    // A neighbour differs when it is invalid (NaN, +Inf: the compare below is false for both)
+    // or more than mu away in depth.
+    const auto differs = [&](std::size_t j, float d) { return !(std::abs(dep[j] - d) <= jump); };
     for (int v = 0; v < h; ++v) {
       const bool inner_row = v > 0 && v + 1 < h;
+      if (inner_row && w > 2) {
+        // Inside the image no bounds to check: branch-free, so the compiler vectorises it.
+        for (int u = 1; u + 1 < w; ++u) {
+          const std::size_t i = static_cast<std::size_t>(v) * w + u;
+          const float d = dep[i];
+          edge[i] = (inv[i] != 0.0f) &
+                    (differs(i + 1, d) | differs(i - 1, d) | differs(i + w, d) | differs(i - w, d));
+        }
+      }
       for (int u = 0; u < w; ++u) {
+        if (inner_row && u > 0 && u + 1 < w) continue;  // done above
         const std::size_t i = static_cast<std::size_t>(v) * w + u;
         if (inv[i] == 0.0f) continue;
         const float d = dep[i];
-        if (inner_row && u > 0 && u + 1 < w) {
-          // No bounds to check: all four neighbours at once, without branches between them.
-          edge[i] = differs(i + 1, d) | differs(i - 1, d) | differs(i + w, d) | differs(i - w, d);
-        } else {
-          edge[i] = (u + 1 < w && differs(i + 1, d)) || (u > 0 && differs(i - 1, d)) ||
-                    (v + 1 < h && differs(i + w, d)) || (v > 0 && differs(i - w, d));
-        }
+        edge[i] = (u + 1 < w && differs(i + 1, d)) || (u > 0 && differs(i - 1, d)) ||
+                  (v + 1 < h && differs(i + w, d)) || (v > 0 && differs(i - w, d));
       }
     }
-    // Dilate by `radius` (separable box: rows, then columns).
+    // Dilate by `radius` (separable box: rows, then columns), as ORs of shifted copies: each
+    // pass is a plain byte loop the compiler vectorises.
     std::vector<std::uint8_t> rows(n, 0);
-    for (int v = 0; v < h; ++v) {
-      int last = -1000000;
-      for (int u = 0; u < w; ++u) {
-        if (edge[static_cast<std::size_t>(v) * w + u]) last = u;
-        if (u - last <= radius) rows[static_cast<std::size_t>(v) * w + u] = 1;
-      }
-      last = 1000000;
-      for (int u = w - 1; u >= 0; --u) {
-        if (edge[static_cast<std::size_t>(v) * w + u]) last = u;
-        if (last - u <= radius) rows[static_cast<std::size_t>(v) * w + u] = 1;
+    for (int k = -radius; k <= radius; ++k) {
+      const int u0 = std::max(0, -k), u1 = std::min(w, w - k);
+      for (int v = 0; v < h; ++v) {
+        const std::uint8_t* src = edge.data() + static_cast<std::size_t>(v) * w + k;
+        std::uint8_t* dst = rows.data() + static_cast<std::size_t>(v) * w;
+        for (int u = u0; u < u1; ++u) dst[u] |= src[u];
       }
     }
     f.near_edge.assign(n, 0);
-    for (int u = 0; u < w; ++u) {
-      int last = -1000000;
-      for (int v = 0; v < h; ++v) {
-        if (rows[static_cast<std::size_t>(v) * w + u]) last = v;
-        if (v - last <= radius) f.near_edge[static_cast<std::size_t>(v) * w + u] = 1;
-      }
-      last = 1000000;
-      for (int v = h - 1; v >= 0; --v) {
-        if (rows[static_cast<std::size_t>(v) * w + u]) last = v;
-        if (last - v <= radius) f.near_edge[static_cast<std::size_t>(v) * w + u] = 1;
+    for (int k = -radius; k <= radius; ++k) {
+      const int v0 = std::max(0, -k), v1 = std::min(h, h - k);
+      for (int v = v0; v < v1; ++v) {
+        const std::uint8_t* src = rows.data() + static_cast<std::size_t>(v + k) * w;
+        std::uint8_t* dst = f.near_edge.data() + static_cast<std::size_t>(v) * w;
+        for (int u = 0; u < w; ++u) dst[u] |= src[u];
       }
     }
   }
@@ -271,6 +282,7 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   const float muf = static_cast<float>(mu), sf = static_cast<float>(s);
   const float u_end = static_cast<float>(w), v_end = static_cast<float>(h);
   const bool interpolate = c.interpolate_depth;
+  const ObservationWeight weight(c, muf);
   for (const Eigen::Vector3i& key : keys) {
     const bool existed = map->find(key) != nullptr;
     TsdfBlock* block = map->allocate(key);
@@ -295,9 +307,10 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
           // centre (no half-pixel bias).
           const float us = fx * p.x() * inv_z + cx;
           const float vs = fy * p.y() * inv_z + cy;
-          // Inside the image: four compares combined without branches between them.
-          if (!((us >= 0.0f) & (vs >= 0.0f) & (us < u_end) & (vs < v_end))) continue;
-          const std::size_t pixel = static_cast<std::size_t>(vs) * w + static_cast<std::size_t>(us);
+          if (!(us >= 0.0f && vs >= 0.0f && us < u_end && vs < v_end)) continue;
+          // Through int: a float to unsigned 64-bit conversion has no single x86 instruction.
+          const std::size_t pixel =
+              static_cast<std::size_t>(static_cast<int>(vs) * w + static_cast<int>(us));
           const float nearest = frame.depth[pixel];
           float sdf;
           if (nearest > max_z) {  // +Inf: no return within range, free along the whole ray
@@ -323,7 +336,7 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
             continue;  // NaN: invalid pixel
           }
           const float dn = std::min(1.0f, sdf / muf);
-          map->fuse(voxel, dn, observationWeight(c, nearest > max_z ? zc : nearest, sdf, muf));
+          map->fuse(voxel, dn, weight(nearest > max_z ? zc : nearest, sdf));
           ++stats.voxels_updated;
           touched = true;
         }
@@ -348,6 +361,7 @@ TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vect
   const TsdfConfig& c = map->config();
   const double s = c.voxel_size_m;
   const double mu = c.truncation();
+  const ObservationWeight weight(c, static_cast<float>(mu));
   const std::uint64_t generation = map->beginIntegration();
   tsl::robin_set<Eigen::Vector3i, BlockIndexHash> touched_keys;
   Eigen::Vector3i cached_key(std::numeric_limits<int>::min(), 0, 0);
@@ -408,7 +422,7 @@ TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vect
         if (sdf >= -mu) {
           const float dn = static_cast<float>(std::min(1.0, sdf / mu));
           map->fuse(&cached->voxels[TsdfMap::localIndex(cell)], dn,
-                    observationWeight(c, range, sdf, mu));
+                    weight(static_cast<float>(range), static_cast<float>(sdf)));
           ++stats.voxels_updated;
         }
       }
