@@ -53,3 +53,12 @@ def test_readme_tsdf_example_runs() -> None:
     # The probe 1 m above the floor's centre is free space, more than mu (0.2 m) from anything.
     distance, weight = namespace["distance_m"], namespace["weight"]
     assert weight[0] == 0.0 or distance[0] > 0.0
+
+
+def test_readme_handoff_example_runs() -> None:
+    namespace = next(ns for ns in run_blocks() if "corridor" in ns)
+    corridor = namespace["corridor"]
+    assert sorted(map(tuple, corridor.tolist())) == [(x, 81) for x in range(142, 161)]
+    cleared = set(map(tuple, namespace["cleared"].tolist()))
+    assert (160, 81) in cleared and (161, 81) in cleared  # 6 cm back, 0.1 m margin around it
+    assert abs(float(namespace["smear"]) - 0.2358) < 5e-4
