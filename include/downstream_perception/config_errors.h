@@ -3,7 +3,9 @@
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <ros/console.h>
 
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -25,5 +27,36 @@ inline void addConfigErrors(diagnostic_updater::DiagnosticStatusWrapper& status,
     status.add("config error " + std::to_string(k + 1), errors[k]);
   }
 }
+
+/// The parameter problems of one component (a layer, a nodelet): each logged once as an error
+/// with the component's prefix and kept for its diagnostics. Safe from any thread (start-up,
+/// dynamic_reconfigure callbacks, the diagnostics timer).
+class ConfigErrorLog {
+ public:
+  void setPrefix(std::string prefix) { prefix_ = std::move(prefix); }
+  void add(const std::string& msg) {
+    ROS_ERROR("%s: %s", prefix_.c_str(), msg.c_str());
+    std::lock_guard<std::mutex> lock(mutex_);
+    errors_.push_back(msg);
+  }
+  std::vector<std::string> all() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return errors_;
+  }
+  /// The count and every message into the status; if any, an ERROR summary with the first one.
+  /// Returns whether there was any.
+  bool report(diagnostic_updater::DiagnosticStatusWrapper& status) const {
+    const std::vector<std::string> errors = all();
+    addConfigErrors(status, errors);
+    if (errors.empty()) return false;
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, errors.front());
+    return true;
+  }
+
+ private:
+  std::string prefix_ = "config";
+  mutable std::mutex mutex_;
+  std::vector<std::string> errors_;
+};
 
 }  // namespace downstream_perception

@@ -27,6 +27,7 @@
 #include "downstream_perception/HandoffConfig.h"
 #include "downstream_perception/SeamHealth.h"
 #include "downstream_perception/TransformPose.h"
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/seam_health.h"
 #include "downstream_perception/planning_frame_relay.h"
 
@@ -48,7 +49,6 @@ class HandoffRos {
   using ReconfigureServer = dynamic_reconfigure::Server<HandoffConfig>;
   void loadParameters();
   void reconfigure(HandoffConfig& config, std::uint32_t level);
-  void configError(const std::string& msg);
   void onGoal(const geometry_msgs::PoseStampedConstPtr& msg);
   bool onTransformPose(TransformPose::Request& req, TransformPose::Response& res);
   /// The pose in target_frame at the pose's stamp; false with the reason in *why.
@@ -77,7 +77,7 @@ class HandoffRos {
   SeamHealth health_;  ///< the last report, also what diagnostics show
   std::size_t goals_ = 0, goal_failures_ = 0, goals_rejected_ = 0;
   std::string last_goal_failure_;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_;
 
   ros::Publisher goal_publisher_, health_publisher_;
   ros::Subscriber goal_subscriber_;

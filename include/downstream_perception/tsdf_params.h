@@ -11,8 +11,8 @@
 namespace downstream_perception {
 
 /// Reads ~voxel_size_m, ~truncation_voxels, ... into a TsdfConfig. An invalid value (or an
-/// invalid combination) is reported in `errors` and the defaults are used for the whole config,
-/// so a map is never built from half-valid settings.
+/// invalid combination) is reported in `errors` (the caller logs it) and the defaults are used for
+/// the whole config, so a map is never built from half-valid settings.
 TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, std::vector<std::string>* errors);
 
 }  // namespace downstream_perception

@@ -29,6 +29,7 @@
 
 #include "downstream_perception/SaveMap.h"
 #include "downstream_perception/TsdfNodeletConfig.h"
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
@@ -78,7 +79,6 @@ class TsdfRos {
   bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void reconfigure(TsdfNodeletConfig& config, std::uint32_t level);
-  void configError(const std::string& msg);
   void reject(const std::string& reason, const std::string& detail);
   void account(const TsdfIntegrationStats& stats, double elapsed_ms);
 
@@ -127,7 +127,7 @@ class TsdfRos {
   double health_period_s_ = 10.0;
   ros::Time last_health_;
   TsdfHealth health_;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_;
 
   using ReconfigureServer = dynamic_reconfigure::Server<TsdfNodeletConfig>;
   std::unique_ptr<ReconfigureServer> reconfigure_server_;

@@ -31,13 +31,8 @@ LogOddsObstacleLayer::~LogOddsObstacleLayer() {
   sources_.clear();
 }
 
-void LogOddsObstacleLayer::reportError(const std::string& msg) {
-  ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-  std::lock_guard<std::mutex> lock(errors_mutex_);
-  config_errors_.push_back(msg);
-}
-
 void LogOddsObstacleLayer::onInitialize() {
+  config_errors_.setPrefix("layer '" + name_ + "'");
   nh_.param("track_unknown_space", track_unknown_space_, layered_costmap_->isTrackingUnknown());
   grid_ = LogOddsGrid(layered_costmap_->costmap().geometry(), grid_config_);
   readSources();
@@ -49,7 +44,7 @@ void LogOddsObstacleLayer::onInitialize() {
   nh_.param("tracks_tf_queue_size", tracks.tf_queue_size, tracks.tf_queue_size);
   const std::string why = tracks.validate();
   if (!why.empty()) {
-    reportError("tracks for clear_tracked_objects: " + why + "; using the defaults");
+    config_errors_.add("tracks for clear_tracked_objects: " + why + "; using the defaults");
     tracks = TrackInboxConfig();
     tracks.include_coasting = false;
   }
@@ -71,9 +66,9 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   model.free_threshold = cfg.free_log_odds;
   std::string why = model.validate();
   if (!why.empty()) {
-    reportError("sensor model invalid (" + why + "); keeping p_hit " +
-                std::to_string(grid_config_.p_hit) + ", p_miss " +
-                std::to_string(grid_config_.p_miss) + " and the previous limits");
+    config_errors_.add("sensor model invalid (" + why + "); keeping p_hit " +
+                       std::to_string(grid_config_.p_hit) + ", p_miss " +
+                       std::to_string(grid_config_.p_miss) + " and the previous limits");
     model = grid_config_;
   }
   ObstacleLayerConfig layer = config_;
@@ -81,14 +76,15 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   if (why.empty()) {
     layer.combination_method = static_cast<CombinationMethod>(cfg.combination_method);
   } else {
-    reportError(why + "; keeping " + std::to_string(static_cast<int>(config_.combination_method)));
+    config_errors_.add(why + "; keeping " +
+                       std::to_string(static_cast<int>(config_.combination_method)));
   }
   if (std::isfinite(cfg.decay_time_s) && cfg.decay_time_s >= 0.0) {
     layer.decay_time_s = cfg.decay_time_s;
   } else {
-    reportError("decay_time_s must be finite and >= 0 s (0 = off), got " +
-                std::to_string(cfg.decay_time_s) + "; keeping " +
-                std::to_string(config_.decay_time_s));
+    config_errors_.add("decay_time_s must be finite and >= 0 s (0 = off), got " +
+                       std::to_string(cfg.decay_time_s) + "; keeping " +
+                       std::to_string(config_.decay_time_s));
   }
   layer.footprint_clearing_enabled = cfg.footprint_clearing_enabled;
   layer.clear_tracked_objects = cfg.clear_tracked_objects;
@@ -96,9 +92,9 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
       cfg.tracked_clearing_margin_m <= 2.0) {
     layer.tracked_clearing_margin_m = cfg.tracked_clearing_margin_m;
   } else {
-    reportError("tracked_clearing_margin_m must be in [0, 2] m, got " +
-                std::to_string(cfg.tracked_clearing_margin_m) + "; keeping " +
-                std::to_string(config_.tracked_clearing_margin_m));
+    config_errors_.add("tracked_clearing_margin_m must be in [0, 2] m, got " +
+                       std::to_string(cfg.tracked_clearing_margin_m) + "; keeping " +
+                       std::to_string(config_.tracked_clearing_margin_m));
   }
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
@@ -146,8 +142,8 @@ void LogOddsObstacleLayer::readSources() {
     std::string data_type;
     snh.param("data_type", data_type, std::string("LaserScan"));
     if (data_type != "LaserScan" && data_type != "PointCloud2") {
-      reportError("source '" + name + "': data_type '" + data_type +
-                  "' is not supported (LaserScan or PointCloud2); source ignored");
+      config_errors_.add("source '" + name + "': data_type '" + data_type +
+                         "' is not supported (LaserScan or PointCloud2); source ignored");
       continue;
     }
     snh.param("topic", config.topic, name);
@@ -177,7 +173,7 @@ void LogOddsObstacleLayer::readSources() {
       why = "tf_queue_size must be in [1, 10000], got " + std::to_string(config.tf_queue_size);
     }
     if (!why.empty()) {
-      reportError("source '" + name + "': " + why + "; source ignored");
+      config_errors_.add("source '" + name + "': " + why + "; source ignored");
       continue;
     }
     auto on_observation = [this](ObservationSource& source, const Observation& observation) {
@@ -442,15 +438,8 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   status.add("decay time (s)", config.decay_time_s);
   status.add("cells decayed to another state (total)", decayed);
   status.add("memory (bytes)", grid_.memoryBytes());
-  std::vector<std::string> errors;
-  {
-    std::lock_guard<std::mutex> lock(errors_mutex_);
-    errors = config_errors_;
-  }
-  addConfigErrors(status, errors);
-  if (!errors.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, errors.front());
-  } else if (!all_current) {
+  if (config_errors_.report(status)) return;  // ERROR, with the first problem
+  if (!all_current) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "a source is not current");
   } else if (!any_integrated) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no message integrated yet");

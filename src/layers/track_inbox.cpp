@@ -136,6 +136,7 @@ FreshTracks TrackInbox::fresh(const ros::Time& now) {
     }
     return out;
   }
+  out.current = true;
   out.tracks = tracks_;
   return out;
 }

@@ -17,19 +17,14 @@ TrackedObstacleLayer::~TrackedObstacleLayer() {
   inbox_.unsubscribe();
 }
 
-void TrackedObstacleLayer::reportError(const std::string& msg) {
-  ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-  std::lock_guard<std::mutex> lock(mutex_);
-  config_errors_.push_back(msg);
-}
-
 void TrackedObstacleLayer::onInitialize() {
+  config_errors_.setPrefix("layer '" + name_ + "'");
   TrackInboxConfig inbox;
   nh_.param("topic", inbox.topic, inbox.topic);
   nh_.param("tf_queue_size", inbox.tf_queue_size, inbox.tf_queue_size);
   const std::string why = inbox.validate();
   if (!why.empty()) {
-    reportError(why + "; using the defaults");
+    config_errors_.add(why + "; using the defaults");
     inbox = TrackInboxConfig();
   }
   inbox_.setConfig(inbox);
@@ -56,8 +51,8 @@ void TrackedObstacleLayer::reconfigure(TrackedObstacleLayerConfig& cfg, std::uin
   }
   std::string why = prediction.validate();
   if (!why.empty()) {
-    reportError(why + "; keeping the previous prediction settings (horizon " +
-                toText(previous.prediction_horizon_s) + " s)");
+    config_errors_.add(why + "; keeping the previous prediction settings (horizon " +
+                       toText(previous.prediction_horizon_s) + " s)");
     prediction = previous;
   }
   TrackInboxConfig inbox = inbox_.config();
@@ -67,7 +62,7 @@ void TrackedObstacleLayer::reconfigure(TrackedObstacleLayerConfig& cfg, std::uin
   inbox.include_coasting = cfg.include_coasting;
   why = inbox.validate();
   if (!why.empty()) {
-    reportError(why + "; keeping " + toText(previous_timeout) + " s");
+    config_errors_.add(why + "; keeping " + toText(previous_timeout) + " s");
     inbox.track_timeout_s = previous_timeout;
   }
   inbox_.setConfig(inbox);
@@ -94,7 +89,7 @@ void TrackedObstacleLayer::updateBounds(double, double, double, double* min_x, d
                                         double* max_x, double* max_y) {
   const FreshTracks fresh = inbox_.fresh(ros::Time::now());
   std::lock_guard<std::mutex> lock(mutex_);
-  current_ = !fresh.stamp.isZero() && fresh.age_s <= inbox_.config().track_timeout_s;
+  current_ = fresh.current;
   const auto grow = [&](double x0, double y0, double x1, double y1) {
     if (x0 > x1) return;
     *min_x = std::min(*min_x, x0);
@@ -161,10 +156,8 @@ void TrackedObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   status.add("tracks drawn (last update)", tracks_drawn_);
   status.add("lethal cells drawn (last update)", cells_.size());
   status.add("prediction_horizon_s", prediction_.prediction_horizon_s);
-  addConfigErrors(status, config_errors_);
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
-  } else if (!enabled_) {
+  if (config_errors_.report(status)) return;  // ERROR, with the first problem
+  if (!enabled_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "disabled");
   } else if (inbox_.arraysReceived() == 0) {
     const std::string last = inbox_.lastRejection();

@@ -13,6 +13,7 @@ namespace downstream_perception {
 
 HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_, nh), diagnostics_(nh, pnh, pnh.getNamespace()) {
+  config_errors_.setPrefix("handoff");
   loadParameters();
   correction_ = CorrectionMonitor(correction_config_);
   health_.map_odom_pose_age_s = -1.0;  // no report yet
@@ -23,8 +24,8 @@ HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("republish", topics.republish, topics.republish);
   pnh_.param("tf_queue_size", topics.tf_queue_size, topics.tf_queue_size);
   if (topics.tf_queue_size < 1 || topics.tf_queue_size > 10000) {
-    configError("parameter tf_queue_size = " + toText(topics.tf_queue_size) +
-                " must be in [1, 10000]; using 20");
+    config_errors_.add("parameter tf_queue_size = " + toText(topics.tf_queue_size) +
+                       " must be in [1, 10000]; using 20");
     topics.tf_queue_size = 20;
   }
   relay_ = std::make_unique<PlanningFrameRelay>(nh_, pnh_, tf_buffer_, planning_frame_, topics);
@@ -46,12 +47,6 @@ HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
            topics.republish ? " re-published in the planning frame" : "");
 }
 
-void HandoffRos::configError(const std::string& msg) {
-  ROS_ERROR("handoff: %s", msg.c_str());
-  std::lock_guard<std::mutex> lock(mutex_);
-  config_errors_.push_back(msg);
-}
-
 void HandoffRos::loadParameters() {
   pnh_.param("planning_frame", planning_frame_, planning_frame_);
   pnh_.param("odom_frame", odom_frame_, odom_frame_);
@@ -65,13 +60,13 @@ void HandoffRos::loadParameters() {
   pnh_.param("correction_min_travel_m", correction_config_.min_travel_m,
              correction_config_.min_travel_m);
   if (!(std::isfinite(health_rate_hz_) && health_rate_hz_ > 0.0 && health_rate_hz_ <= 1000.0)) {
-    configError("parameter health_rate_hz = " + toText(health_rate_hz_) +
-                " must be in (0, 1000] Hz; using 2.0");
+    config_errors_.add("parameter health_rate_hz = " + toText(health_rate_hz_) +
+                       " must be in (0, 1000] Hz; using 2.0");
     health_rate_hz_ = 2.0;
   }
   const std::string why = correction_config_.validate();
   if (!why.empty()) {
-    configError(why + "; using the defaults");
+    config_errors_.add(why + "; using the defaults");
     correction_config_ = CorrectionMonitorConfig();
   }
 }
@@ -87,8 +82,8 @@ void HandoffRos::reconfigure(HandoffConfig& cfg, std::uint32_t) {
       *target = value;
       return;
     }
-    configError(std::string("parameter ") + name + " = " + toText(value) +
-                " must be > 0; keeping " + toText(*target));
+    config_errors_.add(std::string("parameter ") + name + " = " + toText(value) +
+                       " must be > 0; keeping " + toText(*target));
   };
   set("reference_range_m", cfg.reference_range_m, &limits.reference_range_m);
   set("max_transform_age_s", cfg.max_transform_age_s, &limits.max_transform_age_s);
@@ -241,10 +236,8 @@ void HandoffRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("goals dropped (no transform at stamp)", goal_failures_);
   status.add("goals rejected (bad pose)", goals_rejected_);
   if (!last_goal_failure_.empty()) status.add("last goal failure", last_goal_failure_);
-  addConfigErrors(status, config_errors_);
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
-  } else if (!health_.warnings.empty()) {
+  if (config_errors_.report(status)) return;  // ERROR, with the first problem
+  if (!health_.warnings.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, health_.warnings.front());
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "seam healthy");

@@ -32,7 +32,6 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, std::vector<std::string>* 
   }
   if (why.empty()) return c;
   errors->push_back("invalid TSDF parameters (" + why + "); using the defaults");
-  ROS_ERROR("tsdf: %s", errors->back().c_str());
   return TsdfConfig{};
 }
 

@@ -120,37 +120,36 @@ std::unique_ptr<tf2_ros::MessageFilter<M>> TsdfRos::tfFilter(
 
 TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
+  config_errors_.setPrefix("tsdf");
   pnh_.param("world_frame", world_frame_, std::string("odom"));
   double mesh_rate_hz = 1.0;
   pnh_.param("mesh_rate_hz", mesh_rate_hz, mesh_rate_hz);
   if (!(std::isfinite(mesh_rate_hz) && mesh_rate_hz > 0.0 && mesh_rate_hz <= 100.0)) {
-    config_errors_.push_back("parameter ~mesh_rate_hz = " + toText(mesh_rate_hz) +
-                             " must be in (0, 100] Hz; using 1");
-    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    config_errors_.add("parameter ~mesh_rate_hz = " + toText(mesh_rate_hz) +
+                       " must be in (0, 100] Hz; using 1");
     mesh_rate_hz = 1.0;
   }
   pnh_.param("health_period_s", health_period_s_, health_period_s_);
   if (!(std::isfinite(health_period_s_) && health_period_s_ >= 0.0)) {
-    config_errors_.push_back("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
-    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    config_errors_.add("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
     health_period_s_ = 10.0;
   }
   pnh_.param("slice_min_z_m", slice_.min_z_m, slice_.min_z_m);
   pnh_.param("slice_max_z_m", slice_.max_z_m, slice_.max_z_m);
   const std::string slice_why = slice_.validate();
   if (!slice_why.empty()) {
-    config_errors_.push_back("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
-    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    config_errors_.add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
     slice_ = TsdfSliceConfig{};
   }
   int tf_queue_size = 10;
   pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
   if (tf_queue_size < 1 || tf_queue_size > 1000) {
-    config_errors_.push_back("parameter ~tf_queue_size must be in [1, 1000]; using 10");
-    ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+    config_errors_.add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
     tf_queue_size = 10;
   }
-  map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
+  std::vector<std::string> tsdf_errors;
+  map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &tsdf_errors));
+  for (const std::string& e : tsdf_errors) config_errors_.add(e);
   OctreeConfig octree;
   pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
   pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
@@ -158,8 +157,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (octree.resolution_m > 0.0) {  // 0 turns the OctoMap off
     const std::string why = octree.validate();
     if (!why.empty()) {
-      config_errors_.push_back("OctoMap parameters invalid (" + why + "); using the defaults");
-      ROS_ERROR("tsdf: %s", config_errors_.back().c_str());
+      config_errors_.add("OctoMap parameters invalid (" + why + "); using the defaults");
       octree = OctreeConfig{};
     }
     octree_ = std::make_unique<OccupancyOctree>(octree);
@@ -205,12 +203,6 @@ TsdfRos::~TsdfRos() {
   cloud_subscriber_.shutdown();
   depth_filter_.reset();
   cloud_filter_.reset();
-}
-
-void TsdfRos::configError(const std::string& msg) {
-  ROS_ERROR("tsdf: %s", msg.c_str());
-  std::lock_guard<std::mutex> lock(mutex_);
-  config_errors_.push_back(msg);
 }
 
 void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
@@ -261,10 +253,11 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
     now = map_->config();
     slice = slice_;
   }
-  if (!why.empty()) configError("live TSDF parameters refused (" + why + "); keeping the previous");
+  if (!why.empty())
+    config_errors_.add("live TSDF parameters refused (" + why + "); keeping the previous");
   if (!slice_why.empty()) {
-    configError("live slice band refused (" + slice_why + "); keeping [" + toText(slice.min_z_m) +
-                ", " + toText(slice.max_z_m) + "] m");
+    config_errors_.add("live slice band refused (" + slice_why + "); keeping [" +
+                       toText(slice.min_z_m) + ", " + toText(slice.max_z_m) + "] m");
   }
   ROS_INFO("tsdf: live settings: max weight %.1f, depth [%.2f, %.2f] m, slice [%.2f, %.2f] m",
            now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m);
@@ -590,10 +583,8 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     status.add("health: double crossings within mu (drift or thin objects)",
                health_.double_crossings);
   }
-  addConfigErrors(status, config_errors_);
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
-  } else if (frames_integrated_ == 0) {
+  if (config_errors_.report(status)) return;  // ERROR, with the first problem
+  if (frames_integrated_ == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame integrated yet");
   } else if (blocks_refused_ > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,

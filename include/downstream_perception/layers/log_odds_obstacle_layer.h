@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "downstream_perception/LogOddsObstacleLayerConfig.h"
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/log_odds_costs.h"
 #include "downstream_perception/core/log_odds_grid.h"
 #include "downstream_perception/layer.h"
@@ -61,7 +62,6 @@ class LogOddsObstacleLayer : public Layer {
   void clearFootprint(double robot_x, double robot_y, double robot_yaw);
   void decay();
   void clearTrackedObjects();
-  void reportError(const std::string& msg);
 
   std::mutex grid_mutex_;  ///< guards grid_, dirty_, evidence_box_
   LogOddsGrid grid_;
@@ -79,8 +79,7 @@ class LogOddsObstacleLayer : public Layer {
   std::size_t tracks_cleared_last_ = 0;
   bool track_unknown_space_ = true;
   std::vector<std::unique_ptr<ObservationSource>> sources_;
-  std::mutex errors_mutex_;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_;
   std::unique_ptr<ReconfigureServer> reconfigure_server_;
   boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
 };

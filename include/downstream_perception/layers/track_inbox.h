@@ -37,6 +37,7 @@ struct TrackInboxConfig {
 struct FreshTracks {
   ros::Time stamp;                  ///< the array's measurement stamp
   double age_s = 0.0;               ///< now - stamp, >= 0
+  bool current = false;             ///< an array within track_timeout_s exists
   std::vector<PlanarTrack> tracks;  ///< empty when none is fresh
 };
 

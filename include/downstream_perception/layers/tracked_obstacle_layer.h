@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "downstream_perception/TrackedObstacleLayerConfig.h"
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
 #include "downstream_perception/layer.h"
 #include "downstream_perception/layers/track_inbox.h"
@@ -42,7 +43,6 @@ class TrackedObstacleLayer : public Layer {
  private:
   using ReconfigureServer = dynamic_reconfigure::Server<TrackedObstacleLayerConfig>;
   void reconfigure(TrackedObstacleLayerConfig& config, std::uint32_t level);
-  void reportError(const std::string& msg);
 
   TrackInbox inbox_;
   std::mutex mutex_;  ///< guards everything below
@@ -51,7 +51,7 @@ class TrackedObstacleLayer : public Layer {
   double drawn_min_x_ = 0.0, drawn_min_y_ = 0.0, drawn_max_x_ = -1.0, drawn_max_y_ = -1.0;
   std::size_t tracks_drawn_ = 0;
   bool subscribed_ = false;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_;
   std::unique_ptr<ReconfigureServer> reconfigure_server_;
   boost::recursive_mutex reconfigure_mutex_;
 };
