@@ -87,6 +87,7 @@ class TsdfRos {
   std::string world_frame_;
   std::mutex mutex_;  ///< guards the map, the mesher and the counters
   std::unique_ptr<TsdfMap> map_;
+  DepthIntegrator integrator_;  ///< keeps the per-pixel buffers between frames
   TsdfMesher mesher_;
   TsdfMeshMarkers markers_;
   std::map<std::string, sensor_msgs::CameraInfo> camera_infos_;  ///< latest per frame id

@@ -27,6 +27,7 @@ namespace {
 struct Tsdf {
   explicit Tsdf(const TsdfConfig& config) : map(config) {}
   TsdfMap map;
+  DepthIntegrator integrator;
   TsdfMesher mesher;
 };
 
@@ -217,20 +218,25 @@ void bindTsdf(py::module& m) {
                                           std::to_string(camera.width) + ")");
             }
             const Eigen::Isometry3d pose = toIsometry(T_map_camera);
-            std::vector<float> metres(static_cast<std::size_t>(depth.size()));
+            // float32 C-contiguous arrays are read in place (ensure() returns a view); other
+            // float layouts are converted, millimetres scaled.
+            py::array_t<float, py::array::c_style | py::array::forcecast> metres;
+            std::vector<float> scaled;
+            const float* data = nullptr;
             if (py::isinstance<py::array_t<std::uint16_t>>(depth)) {
               const auto mm = py::array_t<std::uint16_t, py::array::c_style>::ensure(depth);
-              millimetresToMetres(mm.data(), metres.size(), metres.data());
+              scaled.resize(static_cast<std::size_t>(depth.size()));
+              millimetresToMetres(mm.data(), scaled.size(), scaled.data());
+              data = scaled.data();
             } else if (py::isinstance<py::array_t<float>>(depth) ||
                        py::isinstance<py::array_t<double>>(depth)) {
-              const auto m =
-                  py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(depth);
-              std::copy(m.data(), m.data() + metres.size(), metres.begin());
+              metres = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(depth);
+              data = metres.data();
             } else {
               throw std::invalid_argument("depth must be float (m) or uint16 (mm)");
             }
             py::gil_scoped_release release;
-            return integrateDepth(&self.map, metres.data(), camera, pose);
+            return self.integrator.integrate(&self.map, data, camera, pose);
           },
           py::arg("depth"), py::arg("camera"), py::arg("T_map_camera"),
           "Fuses a depth image: float32 metres (NaN/0 invalid, +Inf no return) or uint16 "

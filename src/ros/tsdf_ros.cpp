@@ -350,7 +350,7 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto t0 = std::chrono::steady_clock::now();
     const TsdfIntegrationStats stats =
-        integrateDepth(map_.get(), metres.data(), camera, T_world_camera);
+        integrator_.integrate(map_.get(), metres.data(), camera, T_world_camera);
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());

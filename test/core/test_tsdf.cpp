@@ -198,6 +198,77 @@ TEST(Tsdf, DepthImageOfAFrontoParallelPlaneMeshesAtItsDepth) {
   EXPECT_LT(worst, 2e-4);  // 0.2 mm at 5 cm voxels
 }
 
+TEST(Tsdf, DepthIntegratorReusedAcrossFramesEqualsFreshIntegration) {
+  // One DepthIntegrator keeps its per-pixel buffers between frames. Frames of another size,
+  // with the edge guard and interpolation switched off and on again between them, must give
+  // bit for bit the maps a fresh integration of each frame gives: nothing stale may leak.
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  TsdfMap reused(c), fresh(c);
+  DepthIntegrator integrator;
+  const PinholeCamera big = smallCamera();
+  PinholeCamera little = big;
+  little.width = 80;
+  little.height = 60;
+  little.fx = little.fy = 75.0;
+  little.cx = 39.5;
+  little.cy = 29.5;
+  // A slanted wall with a nearer box in front of it (depth edges), a hole and a no-return
+  // patch.
+  const auto scene = [](const PinholeCamera& camera, double wall_z) {
+    std::vector<float> depth =
+        planeDepth(camera, Eigen::Vector3d(0.3, 0.2, 1.0).normalized(), wall_z);
+    for (int v = camera.height / 4; v < camera.height / 2; ++v) {
+      for (int u = camera.width / 3; u < camera.width / 2; ++u) {
+        depth[static_cast<std::size_t>(v) * camera.width + u] = static_cast<float>(wall_z - 0.6);
+      }
+    }
+    depth[5] = std::nanf("");
+    for (int u = 0; u < camera.width / 4; ++u) {
+      depth[static_cast<std::size_t>(camera.height - 1) * camera.width + u] =
+          std::numeric_limits<float>::infinity();
+    }
+    return depth;
+  };
+  struct Frame {
+    PinholeCamera camera;
+    double wall_z;
+    bool guard_and_interpolation;
+  };
+  const Frame frames[] = {
+      {big, 2.0, true}, {little, 2.2, false}, {big, 1.9, true}, {little, 2.1, true}};
+  for (const Frame& f : frames) {
+    TsdfConfig next = c;
+    next.edge_guard_rad = f.guard_and_interpolation ? 0.02 : 0.0;
+    next.interpolate_depth = f.guard_and_interpolation;
+    ASSERT_TRUE(reused.setConfig(next).empty());
+    ASSERT_TRUE(fresh.setConfig(next).empty());
+    const std::vector<float> depth = scene(f.camera, f.wall_z);
+    Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+    T_map_camera.translation().x() = 0.03 * f.wall_z;
+    const TsdfIntegrationStats a =
+        integrator.integrate(&reused, depth.data(), f.camera, T_map_camera);
+    const TsdfIntegrationStats b = integrateDepth(&fresh, depth.data(), f.camera, T_map_camera);
+    EXPECT_EQ(a.voxels_updated, b.voxels_updated);
+    EXPECT_EQ(a.pixels_valid, b.pixels_valid);
+    EXPECT_EQ(a.pixels_invalid, b.pixels_invalid);
+    EXPECT_EQ(a.pixels_no_return, b.pixels_no_return);
+    EXPECT_GT(a.voxels_updated, 0u);
+  }
+  ASSERT_EQ(reused.blockCount(), fresh.blockCount());
+  std::size_t compared = 0;
+  for (const auto& kv : fresh.blocks()) {
+    const TsdfBlock* other = reused.find(kv.first);
+    ASSERT_NE(other, nullptr);
+    for (int i = 0; i < kTsdfBlockVoxels; ++i) {
+      ASSERT_EQ(kv.second->voxels[i].distance, other->voxels[i].distance);
+      ASSERT_EQ(kv.second->voxels[i].weight, other->voxels[i].weight);
+      compared += kv.second->voxels[i].weight > 0.0f;
+    }
+  }
+  EXPECT_GT(compared, 1000u);
+}
+
 TEST(Tsdf, ObliquePlaneFromSeveralViewsIsUnbiased) {
   // Nearest-pixel rounding (not truncation) and the range-along-ray sdf: vertices of a plane
   // tilted 40 degrees, fused from three camera positions, lie on it (no half-pixel bias).

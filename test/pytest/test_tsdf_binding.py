@@ -78,6 +78,27 @@ def test_millimetre_and_metre_depth_agree() -> None:
     np.testing.assert_allclose(a.sample(probe)[0], b.sample(probe)[0], atol=1e-6, equal_nan=True)
 
 
+def test_float_layouts_fuse_identically() -> None:
+    # float32 C-contiguous depth is read in place, other float layouts are converted: a float64
+    # copy and a Fortran-ordered float32 copy of the same frame must fuse to the same map.
+    cam = DepthCamera()
+    pose = look_at(np.array([1.2, 0.3, 1.5]), np.array([0.0, 0.0, 0.6]))
+    depth = cam.render(room_scene(), pose).astype(np.float32)
+    layouts = [depth, depth.astype(np.float64), np.asfortranarray(depth)]
+    assert not layouts[2].flags.c_contiguous
+    maps = [dp.Tsdf() for _ in layouts]
+    updated = [
+        m.integrate_depth(d, camera(cam), pose).voxels_updated
+        for m, d in zip(maps, layouts, strict=True)
+    ]
+    assert updated[0] > 0 and updated.count(updated[0]) == 3
+    probe = np.random.default_rng(3).uniform([-1.0, -1.0, 0.0], [1.5, 1.5, 1.5], size=(2000, 3))
+    reference = maps[0].sample(probe)[0]
+    assert np.isfinite(reference).sum() > 100
+    for other in maps[1:]:
+        np.testing.assert_array_equal(other.sample(probe)[0], reference)
+
+
 def test_bad_input_is_refused_with_a_reason() -> None:
     tsdf = dp.Tsdf()
     cam = DepthCamera()

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -32,10 +33,11 @@ class ObservationWeight {
       : inverse_square_(c.weighting == TsdfConfig::Weighting::kInverseSquareDepth),
         dropoff_(c.behind_surface_dropoff),
         s_(static_cast<float>(c.voxel_size_m)),
-        mu_(mu) {}
+        mu_(mu),
+        inv_dropoff_span_(1.0f / (mu - s_)) {}
   float operator()(float z, float sdf) const {
     float w = inverse_square_ ? 1.0f / (z * z) : 1.0f;
-    if (dropoff_ && sdf < -s_) w *= (mu_ + sdf) / (mu_ - s_);
+    if (dropoff_ && sdf < -s_) w *= (mu_ + sdf) * inv_dropoff_span_;
     return w;
   }
 
@@ -44,6 +46,9 @@ class ObservationWeight {
   bool dropoff_;
   float s_;
   float mu_;
+  /// 1 / (mu - s): infinite when mu = s (truncation_voxels 1), but then no voxel with
+  /// sdf < -s = -mu reaches the drop-off (both integrators skip sdf < -mu first).
+  float inv_dropoff_span_;
 };
 
 Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
@@ -58,14 +63,21 @@ Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, double inv_voxel) {
 
 // A depth image checked once per frame: depth (m; NaN invalid, +Inf no return) and inverse
 // depth (1/m; 0 where not a finite valid depth), so the per-voxel loop does no validation and no
-// division for interpolation.
+// division for interpolation. A DepthIntegrator keeps one and reuses it: a frame overwrites every
+// element, so frames of one size allocate and zero nothing.
 struct DepthFrame {
   std::vector<float> depth;
   std::vector<float> inverse;
-  const float* range_per_depth = nullptr;  ///< |(x/z, y/z, 1)| of each pixel's ray
+  /// |(x/z, y/z, 1)| of each pixel's ray; depends on the intrinsics only, so recomputed only
+  /// when they change.
+  std::vector<float> range_per_depth;
+  PinholeCamera camera;  ///< the intrinsics range_per_depth was computed for
   /// Pixels within edge_guard_rad of a depth edge (a jump of more than mu between neighbours, or
-  /// an invalid neighbour): what lies behind them is not known to be behind a surface.
+  /// an invalid neighbour): what lies behind them is not known to be behind a surface. Empty
+  /// when the guard is off.
   std::vector<std::uint8_t> near_edge;
+  std::vector<std::uint8_t> edge;  ///< scratch: the edges before dilation
+  std::vector<std::uint8_t> rows;  ///< scratch: the edges dilated along rows
   /// 1 where the 2 x 2 pixels from this one (right, down) are all valid depths within a voxel
   /// of each other: inverse depth may be interpolated between them. Checked once per pixel here
   /// instead of once per voxel in the integration loop (empty without interpolate_depth).
@@ -73,116 +85,150 @@ struct DepthFrame {
   float min_depth = std::numeric_limits<float>::infinity();
 };
 
-DepthFrame prepare(const float* depth, const PinholeCamera& camera, const TsdfConfig& c,
-                   TsdfIntegrationStats* stats) {
-  DepthFrame f;
+void computeRangePerDepth(const PinholeCamera& camera, DepthFrame* f) {
   const std::size_t n = static_cast<std::size_t>(camera.width) * camera.height;
+  if (f->range_per_depth.size() == n && f->camera.fx == camera.fx && f->camera.fy == camera.fy &&
+      f->camera.cx == camera.cx && f->camera.cy == camera.cy && f->camera.width == camera.width) {
+    return;
+  }
+  f->range_per_depth.resize(n);
+  for (int v = 0; v < camera.height; ++v) {
+    const double y = (v - camera.cy) / camera.fy;
+    for (int u = 0; u < camera.width; ++u) {
+      const double x = (u - camera.cx) / camera.fx;
+      f->range_per_depth[static_cast<std::size_t>(v) * camera.width + u] =
+          static_cast<float>(std::sqrt(1.0 + x * x + y * y));
+    }
+  }
+  f->camera = camera;
+}
+
+/// Marks pixels next to a depth jump of more than `jump` (m) or to an invalid pixel, then
+/// dilates the marks by `radius` pixels (a separable box). Every pass is a plain loop without
+/// branches, which the compiler vectorises.
+void markNearEdges(int w, int h, float jump, int radius, DepthFrame* f) {
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  f->edge.resize(n);
+  f->rows.resize(n);
+  f->near_edge.resize(n);
+  const float* inv = f->inverse.data();
+  const float* dep = f->depth.data();
+  std::uint8_t* edge = f->edge.data();
+  // A neighbour differs when it is invalid (NaN, +Inf: the compare below is false for both)
+  // or more than `jump` away in depth.
+  const auto differs = [&](std::size_t j, float d) { return !(std::abs(dep[j] - d) <= jump); };
+  const auto borderPixel = [&](int u, int v) {
+    const std::size_t i = static_cast<std::size_t>(v) * w + u;
+    const float d = dep[i];
+    edge[i] = inv[i] != 0.0f && ((u + 1 < w && differs(i + 1, d)) || (u > 0 && differs(i - 1, d)) ||
+                                 (v + 1 < h && differs(i + w, d)) || (v > 0 && differs(i - w, d)));
+  };
+  for (int v = 0; v < h; ++v) {
+    if (v == 0 || v + 1 == h) {
+      for (int u = 0; u < w; ++u) borderPixel(u, v);
+      continue;
+    }
+    borderPixel(0, v);
+    for (int u = 1; u + 1 < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      const float d = dep[i];
+      edge[i] = (inv[i] != 0.0f) &
+                (differs(i + 1, d) | differs(i - 1, d) | differs(i + w, d) | differs(i - w, d));
+    }
+    if (w > 1) borderPixel(w - 1, v);
+  }
+  // Dilation along rows, then columns: each output is the OR of its window, the first term
+  // assigned (so the buffers need no clearing), the others ORed in.
+  for (int v = 0; v < h; ++v) {
+    const std::uint8_t* src = edge + static_cast<std::size_t>(v) * w;
+    std::uint8_t* dst = f->rows.data() + static_cast<std::size_t>(v) * w;
+    for (int u = 0; u < w; ++u) dst[u] = src[u];
+    for (int k = 1; k <= radius && k < w; ++k) {
+      for (int u = 0; u + k < w; ++u) dst[u] |= src[u + k];
+      for (int u = k; u < w; ++u) dst[u] |= src[u - k];
+    }
+  }
+  const std::uint8_t* rows = f->rows.data();
+  std::uint8_t* out = f->near_edge.data();
+  for (int v = 0; v < h; ++v) {
+    std::uint8_t* dst = out + static_cast<std::size_t>(v) * w;
+    const int v0 = std::max(0, v - radius), v1 = std::min(h - 1, v + radius);
+    const std::uint8_t* first = rows + static_cast<std::size_t>(v0) * w;
+    for (int u = 0; u < w; ++u) dst[u] = first[u];
+    for (int k = v0 + 1; k <= v1; ++k) {
+      const std::uint8_t* src = rows + static_cast<std::size_t>(k) * w;
+      for (int u = 0; u < w; ++u) dst[u] |= src[u];
+    }
+  }
+}
+
+/// The frame's depths checked and its per-pixel tables filled (reusing f's buffers).
+void prepare(const float* depth, const PinholeCamera& camera, const TsdfConfig& c,
+             TsdfIntegrationStats* stats, DepthFrame* frame) {
+  DepthFrame& f = *frame;
+  const int w = camera.width, h = camera.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  computeRangePerDepth(camera, &f);
   f.depth.resize(n);
   f.inverse.resize(n);
-  // |ray| / z per pixel depends on the intrinsics only: computed once per camera (per thread).
-  thread_local PinholeCamera cached_camera;
-  thread_local std::vector<float> cached_range;
-  if (cached_range.size() != n || cached_camera.fx != camera.fx || cached_camera.fy != camera.fy ||
-      cached_camera.cx != camera.cx || cached_camera.cy != camera.cy ||
-      cached_camera.width != camera.width) {
-    cached_range.resize(n);
-    for (int v = 0; v < camera.height; ++v) {
-      const double y = (v - camera.cy) / camera.fy;
-      for (int u = 0; u < camera.width; ++u) {
-        const double x = (u - camera.cx) / camera.fx;
-        cached_range[static_cast<std::size_t>(v) * camera.width + u] =
-            static_cast<float>(std::sqrt(1.0 + x * x + y * y));
-      }
-    }
-    cached_camera = camera;
-  }
-  f.range_per_depth = cached_range.data();
+  // Branch-free classification (vectorised): NaN, 0, negatives and out-of-range depths fail
+  // both compares.
+  const float min_d = static_cast<float>(c.min_depth_m), max_d = static_cast<float>(c.max_depth_m);
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // Raw pointers: the byte stores below may alias anything, so through the vectors the
+  // compiler would reload their data pointers at every pixel.
+  float* out_depth = f.depth.data();
+  float* out_inverse = f.inverse.data();
+  std::uint32_t valid_count = 0, no_return_count = 0;  // 32-bit: same lane width as the floats
+  // The nearest valid depth, as the bits of a positive float (which order like the floats):
+  // an integer minimum vectorises, a float one would need -ffinite-math-only.
+  std::int32_t min_bits = 0x7f800000;  // +Inf
   for (std::size_t i = 0; i < n; ++i) {
     const float d = depth[i];
-    if (std::isinf(d) && d > 0.0f) {
-      ++stats->pixels_no_return;
-      f.depth[i] = d;
-      f.inverse[i] = 0.0f;
-    } else if (d >= c.min_depth_m && d <= c.max_depth_m) {
-      ++stats->pixels_valid;
-      f.depth[i] = d;
-      f.inverse[i] = 1.0f / d;
-      f.min_depth = std::min(f.min_depth, d);
-    } else {
-      ++stats->pixels_invalid;
-      f.depth[i] = std::numeric_limits<float>::quiet_NaN();
-      f.inverse[i] = 0.0f;
-    }
+    const bool valid = (d >= min_d) & (d <= max_d);
+    const bool no_return = d == inf;
+    valid_count += valid;
+    no_return_count += no_return;
+    out_depth[i] = valid | no_return ? d : nan;
+    const float inverse = 1.0f / d;  // unconditional, so the loop has no branch
+    out_inverse[i] = valid ? inverse : 0.0f;
+    std::int32_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    min_bits = std::min(min_bits, valid ? bits : 0x7f800000);
   }
+  std::memcpy(&f.min_depth, &min_bits, sizeof min_bits);
+  stats->pixels_valid += valid_count;
+  stats->pixels_no_return += no_return_count;
+  stats->pixels_invalid += n - valid_count - no_return_count;
   if (c.interpolate_depth) {
-    const int w = camera.width, h = camera.height;
     const float max_step = static_cast<float>(c.voxel_size_m);
-    f.smooth.assign(n, 0);
+    f.smooth.resize(n);
+    std::uint8_t* smooth = f.smooth.data();
     for (int v = 0; v + 1 < h; ++v) {
+      const std::size_t row = static_cast<std::size_t>(v) * w;
+      const float* inv = out_inverse + row;
+      const float* d = out_depth + row;
+      std::uint8_t* out = smooth + row;
       for (int u = 0; u + 1 < w; ++u) {
-        const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        const float* inv = f.inverse.data() + i;
-        const float* d = f.depth.data() + i;
-        const float lo = std::min(std::min(d[0], d[1]), std::min(d[w], d[w + 1]));
-        const float hi = std::max(std::max(d[0], d[1]), std::max(d[w], d[w + 1]));
-        f.smooth[i] = (inv[0] != 0.0f) & (inv[1] != 0.0f) & (inv[w] != 0.0f) &
-                      (inv[w + 1] != 0.0f) & (hi - lo <= max_step);
+        const float lo = std::min(std::min(d[u], d[u + 1]), std::min(d[u + w], d[u + w + 1]));
+        const float hi = std::max(std::max(d[u], d[u + 1]), std::max(d[u + w], d[u + w + 1]));
+        out[u] = (inv[u] != 0.0f) & (inv[u + 1] != 0.0f) & (inv[u + w] != 0.0f) &
+                 (inv[u + w + 1] != 0.0f) & (hi - lo <= max_step);
       }
+      out[w - 1] = 0;
     }
+    std::fill(smooth + n - w, smooth + n, 0);
+  } else {
+    f.smooth.clear();
   }
   const int radius =
       static_cast<int>(std::ceil(c.edge_guard_rad * std::max(camera.fx, camera.fy) - 1e-9));
   if (radius > 0) {
-    const int w = camera.width, h = camera.height;
-    std::vector<std::uint8_t> edge(n, 0);
-    const float jump = static_cast<float>(c.truncation());
-    const float* inv = f.inverse.data();
-    const float* dep = f.depth.data();
-    // A neighbour differs when it is invalid (NaN, +Inf: the compare below is false for both)
-    // or more than mu away in depth.
-    const auto differs = [&](std::size_t j, float d) { return !(std::abs(dep[j] - d) <= jump); };
-    for (int v = 0; v < h; ++v) {
-      const bool inner_row = v > 0 && v + 1 < h;
-      if (inner_row && w > 2) {
-        // Inside the image no bounds to check: branch-free, so the compiler vectorises it.
-        for (int u = 1; u + 1 < w; ++u) {
-          const std::size_t i = static_cast<std::size_t>(v) * w + u;
-          const float d = dep[i];
-          edge[i] = (inv[i] != 0.0f) &
-                    (differs(i + 1, d) | differs(i - 1, d) | differs(i + w, d) | differs(i - w, d));
-        }
-      }
-      for (int u = 0; u < w; ++u) {
-        if (inner_row && u > 0 && u + 1 < w) continue;  // done above
-        const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        if (inv[i] == 0.0f) continue;
-        const float d = dep[i];
-        edge[i] = (u + 1 < w && differs(i + 1, d)) || (u > 0 && differs(i - 1, d)) ||
-                  (v + 1 < h && differs(i + w, d)) || (v > 0 && differs(i - w, d));
-      }
-    }
-    // Dilate by `radius` (separable box: rows, then columns), as ORs of shifted copies: each
-    // pass is a plain byte loop the compiler vectorises.
-    std::vector<std::uint8_t> rows(n, 0);
-    for (int k = -radius; k <= radius; ++k) {
-      const int u0 = std::max(0, -k), u1 = std::min(w, w - k);
-      for (int v = 0; v < h; ++v) {
-        const std::uint8_t* src = edge.data() + static_cast<std::size_t>(v) * w + k;
-        std::uint8_t* dst = rows.data() + static_cast<std::size_t>(v) * w;
-        for (int u = u0; u < u1; ++u) dst[u] |= src[u];
-      }
-    }
-    f.near_edge.assign(n, 0);
-    for (int k = -radius; k <= radius; ++k) {
-      const int v0 = std::max(0, -k), v1 = std::min(h, h - k);
-      for (int v = v0; v < v1; ++v) {
-        const std::uint8_t* src = rows.data() + static_cast<std::size_t>(v + k) * w;
-        std::uint8_t* dst = f.near_edge.data() + static_cast<std::size_t>(v) * w;
-        for (int u = 0; u < w; ++u) dst[u] |= src[u];
-      }
-    }
+    markNearEdges(w, h, static_cast<float>(c.truncation()), radius, &f);
+  } else {
+    f.near_edge.clear();
   }
-  return f;
 }
 
 /// Depth at a sub-pixel position: inverse depth interpolated bilinearly between the four
@@ -255,8 +301,17 @@ void evict(TsdfMap* map, const Eigen::Vector3d& origin, TsdfIntegrationStats* st
 
 }  // namespace
 
-TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const PinholeCamera& camera,
-                                    const Eigen::Isometry3d& T_map_camera) {
+struct DepthIntegrator::Buffers : DepthFrame {};
+
+DepthIntegrator::DepthIntegrator() : buffers_(std::make_unique<Buffers>()) {}
+DepthIntegrator::~DepthIntegrator() = default;
+DepthIntegrator::DepthIntegrator(DepthIntegrator&&) noexcept = default;
+DepthIntegrator& DepthIntegrator::operator=(DepthIntegrator&&) noexcept = default;
+
+TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth,
+                                                const PinholeCamera& camera,
+                                                const Eigen::Isometry3d& T_map_camera) {
+  DepthFrame* scratch = buffers_.get();
   TsdfIntegrationStats stats;
   const TsdfConfig& c = map->config();
   const double s = c.voxel_size_m;
@@ -264,7 +319,8 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   const int w = camera.width;
   const int h = camera.height;
   const std::uint64_t generation = map->beginIntegration();
-  const DepthFrame frame = prepare(depth, camera, c, &stats);
+  prepare(depth, camera, c, &stats, scratch);
+  const DepthFrame& frame = *scratch;
   const auto keys = bandBlocks(frame, camera, T_map_camera, c);
 
   // Every voxel of those blocks: project to the nearest pixel centre, fuse.
@@ -283,6 +339,7 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   const float u_end = static_cast<float>(w), v_end = static_cast<float>(h);
   const bool interpolate = c.interpolate_depth;
   const ObservationWeight weight(c, muf);
+  const float inv_mu = 1.0f / muf;
   for (const Eigen::Vector3i& key : keys) {
     const bool existed = map->find(key) != nullptr;
     TsdfBlock* block = map->allocate(key);
@@ -297,46 +354,62 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
         (T_camera_map * ((key * kTsdfBlockSide).cast<double>() * s)).cast<float>();
     for (int z = 0; z < kTsdfBlockSide; ++z) {
       for (int y = 0; y < kTsdfBlockSide; ++y) {
-        Eigen::Vector3f p = base + dz * static_cast<float>(z) + dy * static_cast<float>(y);
-        TsdfVoxel* voxel = &block->voxels[TsdfBlock::linear(0, y, z)];
-        for (int x = 0; x < kTsdfBlockSide; ++x, p += dx, ++voxel) {
-          const float zc = p.z();
-          if (zc < min_z) continue;
-          const float inv_z = 1.0f / zc;
-          // Shifted by half a pixel, so truncation below is rounding to the nearest pixel
-          // centre (no half-pixel bias).
-          const float us = fx * p.x() * inv_z + cx;
-          const float vs = fy * p.y() * inv_z + cy;
-          if (!(us >= 0.0f && vs >= 0.0f && us < u_end && vs < v_end)) continue;
-          // Through int: a float to unsigned 64-bit conversion has no single x86 instruction.
-          const std::size_t pixel =
-              static_cast<std::size_t>(static_cast<int>(vs) * w + static_cast<int>(us));
-          const float nearest = frame.depth[pixel];
+        const Eigen::Vector3f row = base + dz * static_cast<float>(z) + dy * static_cast<float>(y);
+        // Pass 1, the row's eight projections at once (plain loops the compiler vectorises):
+        // depth along the axis, the pixel coordinates shifted by half a pixel (so truncation is
+        // rounding to the nearest pixel centre: no half-pixel bias) and the pixel, or -1 when
+        // the voxel is too close or outside the image.
+        alignas(32) float zc[kTsdfBlockSide], us[kTsdfBlockSide], vs[kTsdfBlockSide];
+        alignas(32) int column[kTsdfBlockSide], line[kTsdfBlockSide];
+        int in_view = 0;
+        for (int x = 0; x < kTsdfBlockSide; ++x) {
+          const float fxv = static_cast<float>(x);
+          const float px = row.x() + dx.x() * fxv;
+          const float py = row.y() + dx.y() * fxv;
+          const float pz = row.z() + dx.z() * fxv;
+          const float inv_z = 1.0f / pz;
+          const float u = fx * px * inv_z + cx;
+          const float v = fy * py * inv_z + cy;
+          const bool ok = (pz >= min_z) & (u >= 0.0f) & (v >= 0.0f) & (u < u_end) & (v < v_end);
+          zc[x] = pz;
+          us[x] = ok ? u : 0.0f;
+          vs[x] = ok ? v : 0.0f;
+          column[x] = ok ? static_cast<int>(us[x]) : -1;
+          line[x] = static_cast<int>(vs[x]);
+          in_view |= ok;
+        }
+        if (!in_view) continue;
+        TsdfVoxel* row_voxels = &block->voxels[TsdfBlock::linear(0, y, z)];
+        // Pass 2, per voxel: the depth it sees and the fusion.
+        for (int x = 0; x < kTsdfBlockSide; ++x) {
+          if (column[x] < 0) continue;
+          const std::size_t px = static_cast<std::size_t>(line[x] * w + column[x]);
+          const float nearest = frame.depth[px];
           float sdf;
           if (nearest > max_z) {  // +Inf: no return within range, free along the whole ray
-            if (zc > max_z) continue;
+            if (zc[x] > max_z) continue;
             sdf = muf;
           } else if (nearest == nearest) {
             // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table. Interpolation
             // moves the depth by at most max_step, so voxels clearly outside the band skip it.
-            const float along_axis = nearest - zc;
+            const float along_axis = nearest - zc[x];
             if (along_axis < -muf - max_step) continue;
             if (along_axis > muf + max_step) {
               sdf = muf;
             } else {
               const float d = interpolate
-                                  ? interpolatedDepth(frame, w, us - 0.5f, vs - 0.5f, nearest)
+                                  ? interpolatedDepth(frame, w, us[x] - 0.5f, vs[x] - 0.5f, nearest)
                                   : nearest;
-              sdf = (d - zc) * frame.range_per_depth[pixel];
+              sdf = (d - zc[x]) * frame.range_per_depth[px];
               if (sdf < -muf) continue;
               // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
-              if (sdf < -sf && !frame.near_edge.empty() && frame.near_edge[pixel]) continue;
+              if (sdf < -sf && !frame.near_edge.empty() && frame.near_edge[px]) continue;
             }
           } else {
             continue;  // NaN: invalid pixel
           }
-          const float dn = std::min(1.0f, sdf / muf);
-          map->fuse(voxel, dn, weight(nearest > max_z ? zc : nearest, sdf));
+          const float dn = std::min(1.0f, sdf * inv_mu);
+          map->fuse(row_voxels + x, dn, weight(nearest > max_z ? zc[x] : nearest, sdf));
           ++stats.voxels_updated;
           touched = true;
         }
@@ -346,6 +419,11 @@ TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const Pinh
   }
   evict(map, T_map_camera.translation(), &stats);
   return stats;
+}
+
+TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const PinholeCamera& camera,
+                                    const Eigen::Isometry3d& T_map_camera) {
+  return DepthIntegrator().integrate(map, depth, camera, T_map_camera);
 }
 
 void millimetresToMetres(const std::uint16_t* millimetres, std::size_t count, float* metres) {

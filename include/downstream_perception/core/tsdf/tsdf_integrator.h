@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,8 +42,26 @@ struct TsdfIntegrationStats {
 /// optical-frame points into the map frame. Each voxel in the touched blocks is projected to its
 /// nearest pixel centre (rounding, not truncation: no half-pixel bias) and updated with
 /// sdf = (depth - z) * |(x/z, y/z, 1)|: the range difference along the ray through the voxel.
+/// Allocates its per-pixel buffers per call; a stream of frames should use a DepthIntegrator.
 TsdfIntegrationStats integrateDepth(TsdfMap* map, const float* depth, const PinholeCamera& camera,
                                     const Eigen::Isometry3d& T_map_camera);
+
+/// Integrates depth images into a map. Keeps its per-pixel buffers (checked and inverse depths,
+/// edge and interpolation masks, ray lengths per pixel) from frame to frame, so frames of one
+/// size allocate nothing: hold one per stream. Not thread-safe; integrate() is as integrateDepth.
+class DepthIntegrator {
+ public:
+  DepthIntegrator();
+  ~DepthIntegrator();
+  DepthIntegrator(DepthIntegrator&&) noexcept;
+  DepthIntegrator& operator=(DepthIntegrator&&) noexcept;
+  TsdfIntegrationStats integrate(TsdfMap* map, const float* depth, const PinholeCamera& camera,
+                                 const Eigen::Isometry3d& T_map_camera);
+
+ private:
+  struct Buffers;
+  std::unique_ptr<Buffers> buffers_;
+};
 
 /// 16UC1 depth (mm, 0 = invalid: REP-118) to metres (NaN where invalid), for integrateDepth.
 void millimetresToMetres(const std::uint16_t* millimetres, std::size_t count, float* metres);
