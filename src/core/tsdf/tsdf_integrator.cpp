@@ -396,28 +396,23 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
           if (column[x] < 0) continue;
           const std::size_t px = static_cast<std::size_t>(line[x] * w + column[x]);
           const float nearest = frame.depth[px];
-          float sdf;
-          if (nearest > max_z) {  // +Inf: no return within range, free along the whole ray
-            if (zc[x] > max_z) continue;
-            sdf = muf;
-          } else if (nearest == nearest) {
-            // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table. Interpolation
-            // moves the depth by at most max_step, so voxels clearly outside the band skip it.
-            const float along_axis = nearest - zc[x];
-            if (along_axis < -muf - max_step) continue;
-            if (along_axis > muf + max_step) {
-              sdf = muf;
-            } else {
-              const float d = interpolate
-                                  ? interpolatedDepth(frame, w, us[x] - 0.5f, vs[x] - 0.5f, nearest)
-                                  : nearest;
-              sdf = (d - zc[x]) * frame.range_per_depth[px];
-              if (sdf < -muf) continue;
-              // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
-              if (sdf < -sf && !frame.near_edge.empty() && frame.near_edge[px]) continue;
-            }
-          } else {
-            continue;  // NaN: invalid pixel
+          // One test drops both invalid pixels (NaN) and voxels clearly behind the band;
+          // +Inf (no return within range) passes it as free space along the whole ray.
+          // Interpolation moves the depth by at most max_step, hence the margins.
+          const float along_axis = nearest - zc[x];
+          if (!(along_axis >= -muf - max_step)) continue;
+          float sdf = muf;
+          if (nearest > max_z) {
+            if (zc[x] > max_z) continue;  // no return: free only up to max_depth_m
+          } else if (along_axis <= muf + max_step) {
+            // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table.
+            const float d = interpolate
+                                ? interpolatedDepth(frame, w, us[x] - 0.5f, vs[x] - 0.5f, nearest)
+                                : nearest;
+            sdf = (d - zc[x]) * frame.range_per_depth[px];
+            if (sdf < -muf) continue;
+            // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
+            if (sdf < -sf && !frame.near_edge.empty() && frame.near_edge[px]) continue;
           }
           const float dn = std::min(1.0f, sdf * inv_mu);
           map->fuse(row_voxels + x, dn, weight(nearest > max_z ? zc[x] : nearest, sdf));
