@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 #include <boost/thread/recursive_mutex.hpp>
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -31,7 +32,7 @@
 #include "downstream_perception/TsdfNodeletConfig.h"
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
-#include "downstream_perception/core/tsdf/occupancy_octree.h"
+#include "downstream_perception/core/tsdf/octree_worker.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
@@ -103,10 +104,9 @@ class TsdfRos {
   ros::Publisher slice_publisher_;
   ros::Publisher octomap_publisher_;
   ros::ServiceServer save_octomap_service_;
-  std::unique_ptr<OccupancyOctree> octree_;  ///< null when ~octomap_resolution_m is 0
-  bool octree_changed_ = false;
-  std::size_t octree_occupied_ = 0;
-  RunningStats octree_ms_;
+  /// Inserts into the OctoMap on its own thread; null when ~octomap_resolution_m is 0.
+  std::unique_ptr<OctreeWorker> octree_;
+  std::atomic<std::size_t> octree_occupied_{0};  ///< set by the publishing timer
   TsdfSliceConfig slice_;
   bool slice_changed_ = false;  ///< the band moved: re-slice at the next mesh tick
   TsdfSliceStats slice_stats_;

@@ -11,7 +11,6 @@
 #include <utility>
 
 #include "downstream_perception/config_errors.h"
-#include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/tf_failure.h"
@@ -154,13 +153,20 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
   pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
   octree.max_range_m = map_->config().max_depth_m;
+  int octree_queue = 2;
+  pnh_.param("octomap_queue_size", octree_queue, octree_queue);
+  if (octree_queue < 1 || octree_queue > 100) {
+    config_errors_.add("parameter ~octomap_queue_size must be in [1, 100]; using 2");
+    octree_queue = 2;
+  }
   if (octree.resolution_m > 0.0) {  // 0 turns the OctoMap off
     const std::string why = octree.validate();
     if (!why.empty()) {
       config_errors_.add("OctoMap parameters invalid (" + why + "); using the defaults");
       octree = OctreeConfig{};
     }
-    octree_ = std::make_unique<OccupancyOctree>(octree);
+    octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octree),
+                                             static_cast<std::size_t>(octree_queue));
   }
 
   mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
@@ -354,14 +360,9 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (octree_) {  // the same observation, as occupancy
-      const auto t1 = std::chrono::steady_clock::now();
-      octree_->insertDepth(metres.data(), camera, T_world_camera);
-      octree_changed_ = true;
-      octree_ms_.add(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
-    }
   }
+  // The same observation, as occupancy, inserted on the OctoMap's own thread.
+  if (octree_) octree_->submitDepth(std::move(metres), camera, T_world_camera);
   diagnostics_.update();
 }
 
@@ -409,14 +410,8 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (octree_) {  // the same observation, as occupancy
-      const auto t1 = std::chrono::steady_clock::now();
-      octree_->insertPoints(points, T_world_sensor.translation());
-      octree_changed_ = true;
-      octree_ms_.add(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
-    }
   }
+  if (octree_) octree_->submitPoints(std::move(points), T_world_sensor.translation());
   diagnostics_.update();
 }
 
@@ -438,10 +433,6 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
       slice = makeSlice(header);
       slice_changed_ = false;
     }
-    if (octree_ && octree_changed_) {
-      occupied = occupiedCloud(header);
-      octree_changed_ = false;
-    }
     mesh_triangles_ = 0;
     for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
     // The health check walks the whole map (tens of ms): every health_period_s at most.
@@ -452,6 +443,14 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
       last_health_ = now;
     }
   }
+  // Outside mutex_: reading the OctoMap waits for an insertion under way, which must not hold
+  // up the TSDF.
+  if (octree_ && octree_->takeChanged()) {
+    std_msgs::Header header;
+    header.frame_id = world_frame_;
+    header.stamp = ros::Time::now();
+    occupied = occupiedCloud(header);
+  }
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
   if (slice) slice_publisher_.publish(slice);
   if (occupied) octomap_publisher_.publish(occupied);
@@ -459,7 +458,8 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
 }
 
 sensor_msgs::PointCloud2Ptr TsdfRos::occupiedCloud(const std_msgs::Header& header) {
-  const std::vector<Eigen::Vector3d> centres = octree_->occupiedCenters();
+  const std::vector<Eigen::Vector3d> centres =
+      octree_->read([](const OccupancyOctree& tree) { return tree.occupiedCenters(); });
   sensor_msgs::PointCloud2Ptr cloud(new sensor_msgs::PointCloud2);
   cloud->header = header;
   sensor_msgs::PointCloud2Modifier modifier(*cloud);
@@ -477,10 +477,11 @@ sensor_msgs::PointCloud2Ptr TsdfRos::occupiedCloud(const std_msgs::Header& heade
 }
 
 bool TsdfRos::saveOctomap(SaveMap::Request& request, SaveMap::Response& response) {
-  std::lock_guard<std::mutex> lock(mutex_);
   replyToSave("save_octomap", request.path, ".bt", response, [&] {
-    const std::string why = octree_->writeBinary(request.path);
-    return std::make_pair(why, std::to_string(octree_->leafCount()) + " leaves");
+    return octree_->read([&](const OccupancyOctree& tree) {
+      return std::make_pair(tree.writeBinary(request.path),
+                            std::to_string(tree.leafCount()) + " leaves");
+    });
   });
   return true;
 }
@@ -530,15 +531,12 @@ bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
     std::lock_guard<std::mutex> lock(mutex_);
     map_->clear();
     mesher_.clear();
-    if (octree_) {
-      octree_->clear();
-      octree_changed_ = true;
-    }
     std_msgs::Header header;
     header.frame_id = world_frame_;
     header.stamp = ros::Time::now();
     markers = markers_.clearAll(header);
   }
+  if (octree_) octree_->clear();
   mesh_publisher_.publish(markers);
   ROS_INFO("tsdf: map cleared");
   return true;
@@ -569,10 +567,15 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("depth range (m)",
              toText(map_->config().min_depth_m) + " .. " + toText(map_->config().max_depth_m));
   if (octree_) {
-    status.add("octomap: leaves", octree_->leafCount());
-    status.add("octomap: occupied leaves", octree_occupied_);
-    status.add("octomap: memory (MB)", static_cast<double>(octree_->memoryBytes()) / 1e6);
-    status.add("octomap: insertion time mean (ms)", octree_ms_.mean());
+    const OctreeWorker::Stats octree = octree_->stats();
+    status.add("octomap: observations inserted", octree.inserted);
+    status.add("octomap: observations dropped (queue full: insertion slower than the sensor)",
+               octree.dropped);
+    status.add("octomap: leaves", octree.leaves);
+    status.add("octomap: occupied leaves", octree_occupied_.load());
+    status.add("octomap: memory (MB)", static_cast<double>(octree.memory_bytes) / 1e6);
+    status.add("octomap: insertion time mean (ms)", octree.insert_ms.mean());
+    status.add("octomap: insertion time max (ms)", octree.insert_ms.max);
   }
   status.add("slice: free cells", slice_stats_.cells_free);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());

@@ -120,6 +120,20 @@ class TsdfRoomTest(unittest.TestCase):
         with open(path, "rb") as f:
             self.assertTrue(f.readline().startswith(b"# Octomap OcTree binary file"))
 
+        # Inserted on its own thread: every integrated frame is inserted or, when insertion
+        # falls behind, dropped from its queue (and counted).
+        def accounted() -> bool:
+            s = self.status
+            return "octomap: observations inserted" in s and int(
+                s["octomap: observations inserted"]
+            ) + int(
+                s["octomap: observations dropped (queue full: insertion slower than the sensor)"]
+            ) == int(s["frames integrated"])
+
+        self.assertTrue(wait_until(accounted, 10.0), f"diagnostics: {self.status}")
+        self.assertGreater(int(self.status["octomap: observations inserted"]), 0)
+        self.assertGreater(int(self.status["octomap: leaves"]), 1000)
+
     def occupied_xy(self, band_bottom: float) -> np.ndarray:
         """Centres (x, y) of the occupied cells of the first slice whose band starts at
         band_bottom (the grid's origin z)."""
@@ -208,6 +222,7 @@ class TsdfRoomTest(unittest.TestCase):
         rospy.ServiceProxy("/tsdf/clear", Empty)()
         self.assertTrue(wait_until(lambda: self.deleted_all, 5.0), "DELETEALL marker")
         self.assertTrue(wait_until(lambda: int(self.status.get("blocks", -1)) == 0, 5.0))
+        self.assertTrue(wait_until(lambda: int(self.status.get("octomap: leaves", -1)) == 0, 5.0))
 
 
 if __name__ == "__main__":
