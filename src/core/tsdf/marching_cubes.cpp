@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 namespace downstream_perception {
 
@@ -130,14 +131,19 @@ std::vector<std::array<int, 3>> deriveCase(int mask) {
 }
 
 // The block's cube corners (lattice 0 .. 8 per axis) plus the border their gradients read
-// (-1 and 9), gathered from the 27 blocks around it once, so the loops index an array.
+// (-1 and 9): the distances gathered from the 27 blocks around it once, NaN where a voxel is
+// missing or lighter than min_weight, so the loops read one small array.
 constexpr int kPad = kTsdfBlockSide + 3;
 struct Neighbourhood {
-  std::array<const TsdfVoxel*, kPad * kPad * kPad> voxels{};
+  std::array<float, kPad * kPad * kPad> distance;
   static int at(int x, int y, int z) { return (x + 1) + kPad * ((y + 1) + kPad * (z + 1)); }
+  float operator()(int x, int y, int z) const { return distance[at(x, y, z)]; }
 };
 
-void gather(const TsdfMap& map, const Eigen::Vector3i& block, Neighbourhood* n) {
+/// Fills n; returns whether a cube of the block can hold a surface: its corners (lattice
+/// 0 .. 8) hold both a negative and a non-negative observed distance. About 40 % of the blocks
+/// of a typical map hold none (free space in front of the surface, or inside).
+bool gather(const TsdfMap& map, const Eigen::Vector3i& block, float min_weight, Neighbourhood* n) {
   std::array<const TsdfBlock*, 27> around{};
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
@@ -151,21 +157,30 @@ void gather(const TsdfMap& map, const Eigen::Vector3i& block, Neighbourhood* n) 
     *offset = a < 0 ? -1 : (a >= kTsdfBlockSide ? 1 : 0);
     *local = a - *offset * kTsdfBlockSide;
   };
+  const float missing = std::numeric_limits<float>::quiet_NaN();
+  bool negative = false, non_negative = false;
   for (int z = -1; z <= kTsdfBlockSide + 1; ++z) {
     int oz, lz;
     split(z, &oz, &lz);
     for (int y = -1; y <= kTsdfBlockSide + 1; ++y) {
       int oy, ly;
       split(y, &oy, &ly);
+      const bool corner_yz = z >= 0 && y >= 0 && z <= kTsdfBlockSide && y <= kTsdfBlockSide;
       for (int x = -1; x <= kTsdfBlockSide + 1; ++x) {
         int ox, lx;
         split(x, &ox, &lx);
         const TsdfBlock* b = around[(ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1))];
-        n->voxels[Neighbourhood::at(x, y, z)] =
-            b == nullptr ? nullptr : &b->voxels[TsdfBlock::linear(lx, ly, lz)];
+        const TsdfVoxel* v = b == nullptr ? nullptr : &b->voxels[TsdfBlock::linear(lx, ly, lz)];
+        const float d = v != nullptr && v->weight > min_weight ? v->distance : missing;
+        n->distance[Neighbourhood::at(x, y, z)] = d;
+        if (corner_yz && x >= 0 && x <= kTsdfBlockSide) {
+          negative |= d < 0.0f;
+          non_negative |= d >= 0.0f;  // NaN is neither
+        }
       }
     }
   }
+  return negative && non_negative;
 }
 
 }  // namespace
@@ -183,7 +198,8 @@ void TriangleMesh::append(const TriangleMesh& other) {
   const auto offset = static_cast<std::uint32_t>(vertices.size());
   vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
   normals.insert(normals.end(), other.normals.begin(), other.normals.end());
-  triangles.reserve(triangles.size() + other.triangles.size());
+  // No exact reserve here: appending block after block, it would reallocate (and copy all) at
+  // every call; push_back grows geometrically.
   for (const std::uint32_t i : other.triangles) triangles.push_back(i + offset);
 }
 
@@ -211,50 +227,48 @@ std::string TriangleMesh::writePly(const std::string& path) const {
 
 TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) {
   TriangleMesh mesh;
-  const float min_weight = static_cast<float>(map.config().min_weight);
   Neighbourhood n;
-  gather(map, block, &n);
-  const auto observed = [&](int x, int y, int z) {
-    const TsdfVoxel* v = n.voxels[Neighbourhood::at(x, y, z)];
-    return v != nullptr && v->weight > min_weight ? v : nullptr;
-  };
+  // A block without a surface is done after the gather.
+  if (!gather(map, block, static_cast<float>(map.config().min_weight), &n)) return mesh;
+  const auto observed = [](float d) { return d == d; };  // not NaN
   // Gradient of D (per voxel) by central differences, one-sided where a neighbour is missing.
   const auto gradient = [&](int x, int y, int z) {
     Eigen::Vector3f g = Eigen::Vector3f::Zero();
     const std::array<int, 3> p = {x, y, z};
+    const float vc = n(x, y, z);
     for (int a = 0; a < 3; ++a) {
       std::array<int, 3> lo = p, hi = p;
       --lo[a];
       ++hi[a];
-      const TsdfVoxel* vl = observed(lo[0], lo[1], lo[2]);
-      const TsdfVoxel* vh = observed(hi[0], hi[1], hi[2]);
-      const TsdfVoxel* vc = observed(x, y, z);
-      if (vl != nullptr && vh != nullptr) {
-        g(a) = 0.5f * (vh->distance - vl->distance);
-      } else if (vh != nullptr && vc != nullptr) {
-        g(a) = vh->distance - vc->distance;
-      } else if (vl != nullptr && vc != nullptr) {
-        g(a) = vc->distance - vl->distance;
+      const float vl = n(lo[0], lo[1], lo[2]);
+      const float vh = n(hi[0], hi[1], hi[2]);
+      if (observed(vl) && observed(vh)) {
+        g(a) = 0.5f * (vh - vl);
+      } else if (observed(vh) && observed(vc)) {
+        g(a) = vh - vc;
+      } else if (observed(vl) && observed(vc)) {
+        g(a) = vc - vl;
       }
     }
     return g;
   };
   // Vertex of each lattice edge (corner lattice index * 3 + axis), shared within the block.
   constexpr int kLattice = kTsdfBlockSide + 1;
-  std::vector<std::int32_t> vertex_of_edge(kLattice * kLattice * kLattice * 3, -1);
+  std::array<std::int32_t, kLattice * kLattice * kLattice * 3> vertex_of_edge;
+  vertex_of_edge.fill(-1);
   const double s = map.voxelSize();
   const Eigen::Vector3i origin = block * kTsdfBlockSide;
   for (int z = 0; z < kTsdfBlockSide; ++z) {
     for (int y = 0; y < kTsdfBlockSide; ++y) {
       for (int x = 0; x < kTsdfBlockSide; ++x) {
-        std::array<const TsdfVoxel*, 8> corner;
+        std::array<float, 8> corner;
         int mask = 0;
         bool complete = true;
-        for (int c = 0; c < 8 && complete; ++c) {
+        for (int c = 0; c < 8; ++c) {
           const auto& o = kCubeCorners[c];
-          corner[c] = observed(x + o[0], y + o[1], z + o[2]);
-          complete = corner[c] != nullptr;
-          if (complete && corner[c]->distance < 0.0f) mask |= 1 << c;
+          corner[c] = n(x + o[0], y + o[1], z + o[2]);
+          complete &= observed(corner[c]);
+          mask |= (corner[c] < 0.0f) << c;
         }
         if (!complete || mask == 0 || mask == 255) continue;
         for (const auto& tri : marchingCubesCase(mask)) {
@@ -276,8 +290,8 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
               const bool a_low = a == lo;
               const std::array<int, 3>& low = a_low ? a : b;
               const std::array<int, 3>& high = a_low ? b : a;
-              const float d_low = corner[kCubeEdges[e][a_low ? 0 : 1]]->distance;
-              const float d_high = corner[kCubeEdges[e][a_low ? 1 : 0]]->distance;
+              const float d_low = corner[kCubeEdges[e][a_low ? 0 : 1]];
+              const float d_high = corner[kCubeEdges[e][a_low ? 1 : 0]];
               const float t = d_low / (d_low - d_high);
               Eigen::Vector3f global((origin.x() + low[0]), (origin.y() + low[1]),
                                      (origin.z() + low[2]));
@@ -328,6 +342,14 @@ std::size_t TsdfMesher::update(const TsdfMap& map) {
 
 TriangleMesh TsdfMesher::combined() const {
   TriangleMesh all;
+  std::size_t vertices = 0, indices = 0;
+  for (const auto& [key, mesh] : meshes_) {
+    vertices += mesh.vertices.size();
+    indices += mesh.triangles.size();
+  }
+  all.vertices.reserve(vertices);
+  all.normals.reserve(vertices);
+  all.triangles.reserve(indices);
   for (const auto& [key, mesh] : meshes_) all.append(mesh);
   return all;
 }
