@@ -325,6 +325,10 @@ def tsdf_report(demo: Session, mesh: MeshCollector, run_s: float, png: Path | No
         "blocks",
         "memory (MB)",
         "mesh update time mean (ms)",
+        "octomap: observations inserted",
+        "octomap: observations dropped (queue full: insertion slower than the sensor)",
+        "octomap: insertion time mean (ms)",
+        "octomap: leaves",
     ):
         if key in diag:
             lines.append(f"| {key} | {diag[key]} |")
