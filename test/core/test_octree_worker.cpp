@@ -5,19 +5,14 @@
 #include <vector>
 
 #include "downstream_perception/core/tsdf/octree_worker.h"
+#include "tsdf_test_scenes.h"
 
 using namespace downstream_perception;
 
 namespace {
 
 PinholeCamera camera() {
-  PinholeCamera c;
-  c.width = 80;
-  c.height = 60;
-  c.fx = c.fy = 75.0;
-  c.cx = 39.5;
-  c.cy = 29.5;
-  return c;
+  return test::smallCamera();
 }
 
 /// A wall `z` metres ahead of a camera at x = `x`.
@@ -98,8 +93,8 @@ TEST(OctreeWorker, AFullQueuePushesOutItsOldestObservation) {
   });
   worker.waitIdle();
   EXPECT_EQ(worker.stats().inserted, 2u);
-  // Along the ray of pixel (42, 30), one of the rays the 4-pixel stride casts (from pixel 2).
-  const auto on_ray = [](double z) { return Eigen::Vector3d(2.5 / 75.0 * z, 0.5 / 75.0 * z, z); };
+  // Along the ray of pixel (82, 62), one of the rays the 4-pixel stride casts (from pixel 2).
+  const auto on_ray = [](double z) { return Eigen::Vector3d(2.5 / 150 * z, 2.5 / 150 * z, z); };
   worker.read([&](const OccupancyOctree& t) {
     EXPECT_GT(logOddsAt(t, on_ray(1.0)), 0.0);  // first: hit, then passed once by the third
     EXPECT_LT(logOddsAt(t, on_ray(2.0)), 0.0);  // second dropped: only passed by the third

@@ -18,6 +18,7 @@
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "tsdf_test_scenes.h"
 
 using namespace downstream_perception;
 
@@ -38,30 +39,8 @@ float distanceAt(const TsdfMap& map, int x, int y = 0, int z = 0) {
   return v == nullptr ? std::nanf("") : v->distance;
 }
 
-// A depth image of the plane n . p = offset (camera frame) seen by `camera`.
-std::vector<float> planeDepth(const PinholeCamera& camera, const Eigen::Vector3d& n,
-                              double offset) {
-  std::vector<float> depth(static_cast<std::size_t>(camera.width) * camera.height);
-  for (int v = 0; v < camera.height; ++v) {
-    for (int u = 0; u < camera.width; ++u) {
-      const Eigen::Vector3d ray((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
-      const double t = offset / n.dot(ray);  // ray * t lies on the plane; t is the depth z
-      depth[static_cast<std::size_t>(v) * camera.width + u] =
-          t > 0.0 ? static_cast<float>(t) : std::nanf("");
-    }
-  }
-  return depth;
-}
-
-PinholeCamera smallCamera() {
-  PinholeCamera c;
-  c.width = 160;
-  c.height = 120;
-  c.fx = c.fy = 150.0;
-  c.cx = 79.5;
-  c.cy = 59.5;
-  return c;
-}
+using test::planeDepth;
+using test::smallCamera;
 
 // Writes D = value(voxel centre) with weight 1 into every voxel of [lo, hi] (inclusive; NaN
 // skips the voxel), then marks every block as changed by one integration.
