@@ -159,6 +159,7 @@ void bindTsdf(py::module& m) {
       .def_readwrite("behind_surface_dropoff", &TsdfConfig::behind_surface_dropoff)
       .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad)
       .def_readwrite("interpolate_depth", &TsdfConfig::interpolate_depth)
+      .def_readwrite("carve_free_space", &TsdfConfig::carve_free_space)
       .def_readwrite("min_depth_m", &TsdfConfig::min_depth_m)
       .def_readwrite("max_depth_m", &TsdfConfig::max_depth_m)
       .def_readwrite("min_weight", &TsdfConfig::min_weight)

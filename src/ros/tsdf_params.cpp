@@ -9,6 +9,7 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, std::vector<std::string>* 
   pnh.param("max_weight", c.max_weight, c.max_weight);
   pnh.param("behind_surface_dropoff", c.behind_surface_dropoff, c.behind_surface_dropoff);
   pnh.param("interpolate_depth", c.interpolate_depth, c.interpolate_depth);
+  pnh.param("carve_free_space", c.carve_free_space, c.carve_free_space);
   pnh.param("edge_guard_rad", c.edge_guard_rad, c.edge_guard_rad);
   pnh.param("min_depth_m", c.min_depth_m, c.min_depth_m);
   pnh.param("max_depth_m", c.max_depth_m, c.max_depth_m);

@@ -229,6 +229,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.behind_surface_dropoff = cfg.behind_surface_dropoff;
   next.edge_guard_rad = cfg.edge_guard_rad;
   next.interpolate_depth = cfg.interpolate_depth;
+  next.carve_free_space = cfg.carve_free_space;
   next.min_depth_m = cfg.min_depth_m;
   next.max_depth_m = cfg.max_depth_m;
   next.min_weight = cfg.min_weight;

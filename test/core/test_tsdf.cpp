@@ -177,6 +177,67 @@ TEST(Tsdf, DepthImageOfAFrontoParallelPlaneMeshesAtItsDepth) {
   EXPECT_LT(worst, 2e-4);  // 0.2 mm at 5 cm voxels
 }
 
+TEST(Tsdf, CarvingErasesWhatMovedAway) {
+  // A wall 1.013 m ahead, seen 5 times, then gone: 10 frames see the wall behind it at 2.013 m.
+  // Only the band around each depth is updated by default, so the first wall stays in the map
+  // (its voxels are more than mu in front of the second); carving updates whole rays and
+  // erases it. An all-"no return" frame carves up to max_depth_m.
+  const PinholeCamera camera = smallCamera();
+  const std::vector<float> near_wall = planeDepth(camera, Eigen::Vector3d::UnitZ(), 1.013);
+  const std::vector<float> far_wall = planeDepth(camera, Eigen::Vector3d::UnitZ(), 2.013);
+  const auto run = [&](bool carve, std::size_t* blocks) {
+    TsdfConfig c;
+    c.voxel_size_m = 0.05;
+    c.carve_free_space = carve;
+    TsdfMap map(c);
+    DepthIntegrator integrator;
+    for (int k = 0; k < 5; ++k) {
+      integrator.integrate(&map, near_wall.data(), camera, Eigen::Isometry3d::Identity());
+    }
+    for (int k = 0; k < 10; ++k) {
+      integrator.integrate(&map, far_wall.data(), camera, Eigen::Isometry3d::Identity());
+    }
+    *blocks = map.blockCount();
+    TsdfMesher mesher;
+    mesher.update(map);
+    const TriangleMesh mesh = mesher.combined();
+    std::size_t near = 0, far = 0;
+    for (const Eigen::Vector3f& v : mesh.vertices) {
+      near += std::abs(v.z() - 1.013f) < 0.03f;
+      far += std::abs(v.z() - 2.013f) < 0.03f;
+    }
+    return std::make_pair(near, far);
+  };
+  std::size_t band_blocks = 0, carved_blocks = 0;
+  const auto [band_near, band_far] = run(false, &band_blocks);
+  const auto [carved_near, carved_far] = run(true, &carved_blocks);
+  EXPECT_GT(band_near, 100u);  // the ghost of the first wall
+  EXPECT_GT(band_far, 100u);
+  EXPECT_EQ(carved_near, 0u);  // erased
+  EXPECT_GT(carved_far, 100u);
+  EXPECT_GT(carved_blocks, band_blocks);  // the free space in front of the walls is allocated
+
+  // No return anywhere: free along every ray up to max_depth_m, and only with carving.
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  c.max_depth_m = 3.0;
+  const std::vector<float> nothing(near_wall.size(), std::numeric_limits<float>::infinity());
+  TsdfMap plain(c);
+  integrateDepth(&plain, nothing.data(), camera, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(plain.blockCount(), 0u);
+  c.carve_free_space = true;
+  TsdfMap carved(c);
+  const TsdfIntegrationStats stats =
+      integrateDepth(&carved, nothing.data(), camera, Eigen::Isometry3d::Identity());
+  EXPECT_GT(stats.voxels_updated, 1000u);
+  for (const double z : {0.5, 1.5, 2.9}) {  // on the optical axis, up to max_depth_m
+    const TsdfVoxel* v = carved.voxel(carved.voxelAt({0.0, 0.0, z}));
+    ASSERT_NE(v, nullptr) << z;
+    EXPECT_EQ(v->distance, 1.0f) << z;
+  }
+  EXPECT_EQ(carved.voxel(carved.voxelAt({0.0, 0.0, 3.3})), nullptr);
+}
+
 TEST(Tsdf, DepthIntegratorReusedAcrossFramesEqualsFreshIntegration) {
   // One DepthIntegrator keeps its per-pixel buffers between frames. Frames of another size,
   // with the edge guard and interpolation switched off and on again between them, must give

@@ -131,6 +131,7 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "behind_surface_dropoff",
         "edge_guard_rad",
         "interpolate_depth",
+        "carve_free_space",
         "min_depth_m",
         "max_depth_m",
         "min_weight",

@@ -197,6 +197,33 @@ def test_edge_guard_removes_ghosts() -> None:
     assert ghosts[0.0075].completeness > ghosts[0.0].completeness - 0.002
 
 
+def test_carving_erases_a_box_that_moved_away() -> None:
+    # The room's box is seen from one pose, then removed: with carving its faces go back to free
+    # space (the wall behind it is seen through where it stood), without carving they stay.
+    cam = DepthCamera()
+    pose = look_at(np.array([-1.0, 0.6, 0.5]), np.array([0.8, 0.6, 0.35]))  # under the table
+    scene = room_scene()
+    with_box = cam.render(scene, pose)
+    scene.boxes = scene.boxes[1:]  # the box is gone; the table top stays
+    without_box = cam.render(scene, pose)
+    # On the box's front face, above the blocks the floor's band allocates (0.4 m at 5 cm).
+    front_face = np.array([[0.8 - 0.3 + 0.0073, 0.6 - 0.0041, 0.6 + 0.0029]])
+    distances = {}
+    for carve in (False, True):
+        config = dp.TsdfConfig()
+        config.voxel_size_m = 0.05
+        config.carve_free_space = carve
+        tsdf = dp.Tsdf(config)
+        for _ in range(3):
+            tsdf.integrate_depth(with_box, camera(cam), pose)
+        for _ in range(6):
+            tsdf.integrate_depth(without_box, camera(cam), pose)
+        distances[carve] = float(tsdf.sample(front_face)[0][0])
+    assert np.sum(np.abs(with_box - without_box) > 0.5) > 2000  # the box filled the view
+    assert abs(distances[False]) < 0.02  # m: the face is still a surface
+    assert distances[True] > 0.1  # m (mu = 0.2): free
+
+
 def test_depth_camera_renders_exact_depths() -> None:
     # Looking straight down from 2 m at the floor (z = 0) of an empty room: depth 2 everywhere
     # the floor is seen, and the true signed distance of the hit points is 0.

@@ -253,21 +253,32 @@ DP_INTEGRATION_STEP float interpolatedDepth(const DepthFrame& f, int w, float uf
                  b * ((1.0f - a) * inv[w] + a * inv[w + 1]));
 }
 
-/// Blocks the truncation band of the valid pixels passes through. Pixels are sampled every
-/// `stride` pixels, where a stride spans at most one voxel at the nearest depth of the frame
-/// (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the same
-/// block, so a one-entry cache per sample along the ray skips most hash lookups.
+/// Blocks the truncation band of the valid pixels passes through (with carve_free_space, the
+/// whole ray from the sensor, and the rays of +Inf pixels up to max_depth_m). Pixels are sampled
+/// every `stride` pixels, where a stride spans at most one voxel at the nearest depth of the
+/// frame (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the
+/// same block, so a one-entry cache per sample along the ray skips most hash lookups.
 DP_INTEGRATION_STEP tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(
     const DepthFrame& f, const PinholeCamera& camera, const Eigen::Isometry3d& T,
     const TsdfConfig& c) {
   tsl::robin_set<Eigen::Vector3i, BlockIndexHash> keys;
-  if (!std::isfinite(f.min_depth)) return keys;
+  // Without a valid depth only carving (along +Inf rays) has anything to do.
+  if (!std::isfinite(f.min_depth) && !c.carve_free_space) return keys;
   const double s = c.voxel_size_m;
   const double mu = c.truncation();
   const double block_m = kTsdfBlockSide * s;
-  const int stride = std::max(
-      1, static_cast<int>(std::floor(0.5 * s * std::min(camera.fx, camera.fy) / f.min_depth)));
-  const int samples = std::max(2, static_cast<int>(std::ceil(2.0 * mu / (0.5 * block_m))) + 1);
+  const double focal = std::min(camera.fx, camera.fy);
+  // Sampled rays at most a voxel apart at the nearest depth; carving also needs them at most
+  // half a block apart at max_depth_m, the farthest it carves.
+  double spacing_px = std::isfinite(f.min_depth) ? 0.5 * s * focal / f.min_depth : 1e9;
+  if (c.carve_free_space) spacing_px = std::min(spacing_px, 0.5 * block_m * focal / c.max_depth_m);
+  const int stride = std::max(1, static_cast<int>(std::floor(spacing_px)));
+  // Samples along each ray at most half a block apart.
+  const auto samplesFor = [&](double length) {
+    return std::max(2, static_cast<int>(std::ceil(length / (0.5 * block_m))) + 1);
+  };
+  const bool carve = c.carve_free_space;
+  const int samples = carve ? samplesFor(c.max_depth_m + mu) : samplesFor(2.0 * mu);
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Vector3d t = T.translation();
   const int w = camera.width, h = camera.height;
@@ -280,15 +291,22 @@ DP_INTEGRATION_STEP tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(
   };
   for (int v = 0; v < h; v = next(v, h)) {
     for (int u = 0; u < w; u = next(u, w)) {
-      const float d = f.depth[static_cast<std::size_t>(v) * w + u];
+      float d = f.depth[static_cast<std::size_t>(v) * w + u];
+      if (carve && d == std::numeric_limits<float>::infinity()) {
+        d = static_cast<float>(c.max_depth_m - mu);  // no return: free up to max_depth_m
+      }
       if (!std::isfinite(d)) continue;
       const Eigen::Vector3d ray((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
       const double norm = ray.norm();
       const double range = d * norm;
       const Eigen::Vector3d dir = R * (ray / norm);
-      const double r0 = std::max(0.0, range - mu);
-      const double step = (range + mu - r0) / (samples - 1);
-      for (int k = 0; k < samples; ++k) {
+      const double r0 = carve ? 0.0 : std::max(0.0, range - mu);
+      const int n = carve ? samplesFor(range + mu) : samples;
+      if (n > static_cast<int>(last.size())) {
+        last.resize(n, Eigen::Vector3i(std::numeric_limits<int>::min(), 0, 0));
+      }
+      const double step = (range + mu - r0) / (n - 1);
+      for (int k = 0; k < n; ++k) {
         const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), 1.0 / s);
         if (key == last[k]) continue;
         last[k] = key;
@@ -465,7 +483,7 @@ TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vect
     const Eigen::Vector3d dir = ray / range;
     // Amanatides-Woo traversal of the voxels (cells [i - 1/2, i + 1/2) in voxel units) from
     // range - mu to range + mu.
-    const double t0 = std::max(0.0, range - mu);
+    const double t0 = c.carve_free_space ? 0.0 : std::max(0.0, range - mu);
     const double t1 = range + mu;
     const Eigen::Vector3d q0 = (origin + dir * t0) / s + Eigen::Vector3d::Constant(0.5);
     Eigen::Vector3i cell(static_cast<int>(std::floor(q0.x())), static_cast<int>(std::floor(q0.y())),

@@ -46,6 +46,11 @@ struct TsdfConfig {
   /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
   /// nearest pixel across depth edges (neighbours differing by more than one voxel).
   bool interpolate_depth = true;
+  /// Update the voxels along the whole ray from the sensor, not only the truncation band: an
+  /// object that moved away is erased where its free space is seen again (voxblox's voxel
+  /// carving; +Inf pixels carve up to max_depth_m). Off by default: it allocates blocks for all
+  /// the free space in view, so memory and time grow with the range.
+  bool carve_free_space = false;
   double min_depth_m = 0.1;   ///< closer depths are invalid
   double max_depth_m = 10.0;  ///< farther depths are invalid
   /// Voxels whose weight is below this are "unobserved" for meshing and queries.
