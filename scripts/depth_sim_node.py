@@ -5,6 +5,8 @@ poses on a circle, published at ~rate_hz.
 Each frame: tf ~world_frame -> ~camera_frame (optical convention) at the frame's stamp, then
 `depth/camera_info` and `depth/image` (32FC1 metres, NaN = no hit; or 16UC1 millimetres, 0 = no
 hit, with ~encoding: 16UC1). After the last frame, latched std_msgs/Bool(True) on `~done`.
+With ~remove_box_after: n (>= 0), frames n and later render the room without its box: an object
+that moved away, for free-space carving.
 """
 
 from __future__ import annotations
@@ -60,6 +62,9 @@ def main() -> None:
         rospy.logerr("depth_sim: ~encoding must be 32FC1 or 16UC1; using 32FC1")
         encoding = "32FC1"
     scene = room_scene()
+    without_box = room_scene()
+    without_box.boxes = without_box.boxes[1:]  # boxes[0] is the box; the table top stays
+    remove_box_after = int(p("~remove_box_after", -1))
     poses = circle_poses(frames)
     rng = np.random.default_rng(int(p("~seed", 0)))
     tf = tf2_ros.TransformBroadcaster()
@@ -68,10 +73,11 @@ def main() -> None:
     done = rospy.Publisher("~done", Bool, queue_size=1, latch=True)
     rospy.sleep(float(p("~start_delay_s", 2.0)))  # let subscribers connect
     rate = rospy.Rate(rate_hz)
-    for T in poses:
+    for k, T in enumerate(poses):
         if rospy.is_shutdown():
             return
-        depth = cam.render(scene, T, depth_noise_m=noise, rng=rng)
+        seen = without_box if 0 <= remove_box_after <= k else scene
+        depth = cam.render(seen, T, depth_noise_m=noise, rng=rng)
         stamp = rospy.Time.now()
         tf.sendTransform(transform_from_matrix(world, optical, stamp, T))
         header = Header(stamp=stamp, frame_id=optical)

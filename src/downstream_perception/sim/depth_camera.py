@@ -50,7 +50,7 @@ class Scene3D:
         lo, hi = np.asarray(self.room_min), np.asarray(self.room_max)
         d = np.min(np.concatenate([p - lo, hi - p], axis=1), axis=1)  # inside the room
         for b in self.boxes:
-            d = np.minimum(d, _box_sdf(p, np.asarray(b.center), np.asarray(b.half_extents)))
+            d = np.minimum(d, box_signed_distance(p, b))
         for s in self.spheres:
             d = np.minimum(d, np.linalg.norm(p - np.asarray(s.center), axis=1) - s.radius)
         for c in self.cylinders:
@@ -213,8 +213,9 @@ def perturb_pose(
 
 
 # ------------------------------------------------------------------ ray / shape helpers
-def _box_sdf(p: np.ndarray, c: np.ndarray, h: np.ndarray) -> np.ndarray:
-    q = np.abs(p - c) - h
+def box_signed_distance(p: np.ndarray, box: Box) -> np.ndarray:
+    """Exact signed distance (m) of points (N, 3) to an axis-aligned box; < 0 inside it."""
+    q = np.abs(p - np.asarray(box.center)) - np.asarray(box.half_extents)
     return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(np.max(q, axis=1), 0.0)
 
 

@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""rostest: free-space carving erases an object that moved away.
+
+The depth simulator takes the room's box away after 10 of 30 frames. The TSDF nodelet with
+carve_free_space updates whole rays, so the box's faces turn back into free space when later
+frames look through where it stood; the nodelet without carving updates only the band around
+each depth and keeps them. Both meshes must still hold the rest of the room.
+"""
+
+from __future__ import annotations
+
+import time
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from diagnostic_msgs.msg import DiagnosticArray
+from std_msgs.msg import Bool
+from visualization_msgs.msg import Marker, MarkerArray
+
+from downstream_perception.ros_util import wait_until
+from downstream_perception.sim.depth_camera import box_signed_distance, room_scene
+
+
+class MeshListener:
+    """The latest mesh of one TSDF nodelet (per-block TRIANGLE_LIST markers)."""
+
+    def __init__(self, topic: str) -> None:
+        self.blocks: dict[int, np.ndarray] = {}
+        rospy.Subscriber(topic, MarkerArray, self.on_mesh, queue_size=20)
+
+    def on_mesh(self, msg: MarkerArray) -> None:
+        for m in msg.markers:
+            if m.action == Marker.DELETEALL:
+                self.blocks.clear()
+            elif m.action == Marker.DELETE:
+                self.blocks.pop(m.id, None)
+            else:
+                self.blocks[m.id] = np.array([[p.x, p.y, p.z] for p in m.points]).reshape(-1, 3)
+
+    def corners(self) -> np.ndarray:
+        return np.vstack(list(self.blocks.values())) if self.blocks else np.zeros((0, 3))
+
+
+class TsdfCarvingTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node("test_tsdf_carving")
+        cls.done = False
+        cls.status: dict[str, dict[str, str]] = {}
+
+        def on_done(msg: Bool) -> None:
+            cls.done = cls.done or msg.data
+
+        def on_diag(msg: DiagnosticArray) -> None:
+            for s in msg.status:
+                for name in ("tsdf_carving", "tsdf_plain"):
+                    if s.name.endswith(f"{name}: tsdf"):
+                        cls.status[name] = {kv.key: kv.value for kv in s.values}
+
+        cls.carving = MeshListener("/tsdf_carving/mesh")
+        cls.plain = MeshListener("/tsdf_plain/mesh")
+        rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
+
+    def test_carving_erases_the_box_that_moved_away(self) -> None:
+        self.assertTrue(wait_until(lambda: self.done, 60.0), "the simulator did not finish")
+        self.assertTrue(
+            wait_until(
+                lambda: all(
+                    int(self.status.get(n, {}).get("frames integrated", 0)) == 30
+                    for n in ("tsdf_carving", "tsdf_plain")
+                ),
+                10.0,
+            ),
+            f"diagnostics: {self.status}",
+        )
+        time.sleep(1.5)  # the next mesh update (2 Hz) after the last frame
+        box = room_scene().boxes[0]
+        counts = {}
+        for name, listener in (("carving", self.carving), ("plain", self.plain)):
+            corners = listener.corners()
+            self.assertGreater(len(corners), 10000, name)  # the rest of the room
+            on_box = np.abs(box_signed_distance(corners, box))
+            counts[name] = int(np.sum((on_box < 0.02) & (corners[:, 2] > 0.1)))  # above the floor
+        self.assertGreater(counts["plain"], 200, counts)  # the box stays without carving
+        self.assertLess(counts["carving"], 10, counts)  # and is gone with it
+        blocks = {n: int(self.status[n]["blocks"]) for n in ("tsdf_carving", "tsdf_plain")}
+        self.assertGreater(blocks["tsdf_carving"], blocks["tsdf_plain"], blocks)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("downstream_perception", "test_tsdf_carving", TsdfCarvingTest)
