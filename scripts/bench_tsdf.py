@@ -7,6 +7,7 @@ Used by bench.py; runnable alone: python3 scripts/bench_tsdf.py
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -19,6 +20,21 @@ OPEN3D_MS = {
     ("320x240", 0.05): (3.07, 3.70),
     ("640x480", 0.05): (4.57, 5.06),
 }
+
+
+def timed_frames(
+    insert: Callable[[np.ndarray, Any, np.ndarray], Any],
+    depths: list[np.ndarray],
+    camera: Any,
+    poses: list[np.ndarray],
+) -> list[float]:
+    """ms taken by insert(depth, camera, pose) for each frame."""
+    elapsed = []
+    for pose, depth in zip(poses, depths, strict=True):
+        t0 = time.perf_counter()
+        insert(depth, camera, pose)
+        elapsed.append(1e3 * (time.perf_counter() - t0))
+    return elapsed
 
 
 def run(frames: int = 30) -> list[dict[str, Any]]:
@@ -39,11 +55,7 @@ def run(frames: int = 30) -> list[dict[str, Any]]:
             config = dp.TsdfConfig()
             config.voxel_size_m = voxel
             tsdf = dp.Tsdf(config)
-            integrate_ms = []
-            for pose, depth in zip(poses, depths, strict=True):
-                t0 = time.perf_counter()
-                tsdf.integrate_depth(depth, pinhole, pose)
-                integrate_ms.append(1e3 * (time.perf_counter() - t0))
+            integrate_ms = timed_frames(tsdf.integrate_depth, depths, pinhole, poses)
             t0 = time.perf_counter()
             tsdf.update_mesh()
             full_mesh_ms = 1e3 * (time.perf_counter() - t0)
@@ -77,11 +89,7 @@ def run(frames: int = 30) -> list[dict[str, Any]]:
     cam, depths = frames["320x240"]
     pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
     tree = dp.OccupancyOctree()
-    insert_ms = []
-    for pose, depth in zip(poses, depths, strict=True):
-        t0 = time.perf_counter()
-        tree.insert_depth(depth, pinhole, pose)
-        insert_ms.append(1e3 * (time.perf_counter() - t0))
+    insert_ms = timed_frames(tree.insert_depth, depths, pinhole, poses)
     rows.append(
         {
             "image": "320x240 / 4 px stride",
@@ -96,11 +104,7 @@ def run(frames: int = 30) -> list[dict[str, Any]]:
         config.voxel_size_m = voxel
         config.carve_free_space = True
         tsdf = dp.Tsdf(config)
-        carve_ms = []
-        for pose, depth in zip(poses, depths, strict=True):
-            t0 = time.perf_counter()
-            tsdf.integrate_depth(depth, pinhole, pose)
-            carve_ms.append(1e3 * (time.perf_counter() - t0))
+        carve_ms = timed_frames(tsdf.integrate_depth, depths, pinhole, poses)
         rows.append(
             {
                 "image": "320x240 carving",

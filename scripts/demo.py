@@ -21,9 +21,12 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from downstream_perception.mesh_collector import MeshCollector
 
 
 def free_port() -> int:
@@ -270,30 +273,6 @@ def tracker_report(demo: Session, run_s: float, png: Path | None) -> list[str]:
     return lines
 
 
-class MeshCollector:
-    """The TSDF mesh as published (per-block TRIANGLE_LIST markers): triangle corners by id."""
-
-    def __init__(self, topic: str) -> None:
-        import rospy
-        from visualization_msgs.msg import Marker, MarkerArray
-
-        self.blocks: dict[int, np.ndarray] = {}
-
-        def on_mesh(msg: MarkerArray) -> None:
-            for m in msg.markers:
-                if m.action == Marker.DELETEALL:
-                    self.blocks.clear()
-                elif m.action == Marker.DELETE:
-                    self.blocks.pop(m.id, None)
-                else:
-                    self.blocks[m.id] = np.array([[p.x, p.y, p.z] for p in m.points])
-
-        self.subscriber = rospy.Subscriber(topic, MarkerArray, on_mesh, queue_size=20)
-
-    def corners(self) -> np.ndarray:
-        return np.vstack(list(self.blocks.values())) if self.blocks else np.empty((0, 3))
-
-
 def tsdf_report(demo: Session, mesh: MeshCollector, run_s: float, png: Path | None) -> list[str]:
     from downstream_perception.sim.depth_camera import room_scene
 
@@ -393,6 +372,7 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
 
     from downstream_perception.costmap_client import CostmapClient
+    from downstream_perception.mesh_collector import MeshCollector
 
     session = Session(out, args.timeout, rviz=not args.no_rviz)
     try:

@@ -420,15 +420,15 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   visualization_msgs::MarkerArray markers;
   nav_msgs::OccupancyGridPtr slice;
   sensor_msgs::PointCloud2Ptr occupied;
+  std_msgs::Header header;
+  header.frame_id = world_frame_;
+  header.stamp = ros::Time::now();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto t0 = std::chrono::steady_clock::now();
     mesher_.update(*map_);  // evicted blocks are reported by markers_.changed() too
     mesh_ms_.add(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    std_msgs::Header header;
-    header.frame_id = world_frame_;
-    header.stamp = ros::Time::now();
     markers = markers_.changed(mesher_, header);
     if (!mesher_.lastUpdated().empty() || !markers.markers.empty() || slice_changed_) {
       slice = makeSlice(header);
@@ -446,12 +446,7 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   }
   // Outside mutex_: reading the OctoMap waits for an insertion under way, which must not hold
   // up the TSDF.
-  if (octree_ && octree_->takeChanged()) {
-    std_msgs::Header header;
-    header.frame_id = world_frame_;
-    header.stamp = ros::Time::now();
-    occupied = occupiedCloud(header);
-  }
+  if (octree_ && octree_->takeChanged()) occupied = occupiedCloud(header);
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
   if (slice) slice_publisher_.publish(slice);
   if (occupied) octomap_publisher_.publish(occupied);

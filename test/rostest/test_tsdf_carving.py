@@ -17,30 +17,10 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
 from std_msgs.msg import Bool
-from visualization_msgs.msg import Marker, MarkerArray
 
+from downstream_perception.mesh_collector import MeshCollector
 from downstream_perception.ros_util import wait_until
 from downstream_perception.sim.depth_camera import box_signed_distance, room_scene
-
-
-class MeshListener:
-    """The latest mesh of one TSDF nodelet (per-block TRIANGLE_LIST markers)."""
-
-    def __init__(self, topic: str) -> None:
-        self.blocks: dict[int, np.ndarray] = {}
-        rospy.Subscriber(topic, MarkerArray, self.on_mesh, queue_size=20)
-
-    def on_mesh(self, msg: MarkerArray) -> None:
-        for m in msg.markers:
-            if m.action == Marker.DELETEALL:
-                self.blocks.clear()
-            elif m.action == Marker.DELETE:
-                self.blocks.pop(m.id, None)
-            else:
-                self.blocks[m.id] = np.array([[p.x, p.y, p.z] for p in m.points]).reshape(-1, 3)
-
-    def corners(self) -> np.ndarray:
-        return np.vstack(list(self.blocks.values())) if self.blocks else np.zeros((0, 3))
 
 
 class TsdfCarvingTest(unittest.TestCase):
@@ -59,8 +39,8 @@ class TsdfCarvingTest(unittest.TestCase):
                     if s.name.endswith(f"{name}: tsdf"):
                         cls.status[name] = {kv.key: kv.value for kv in s.values}
 
-        cls.carving = MeshListener("/tsdf_carving/mesh")
-        cls.plain = MeshListener("/tsdf_plain/mesh")
+        cls.carving = MeshCollector("/tsdf_carving/mesh")
+        cls.plain = MeshCollector("/tsdf_plain/mesh")
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
 

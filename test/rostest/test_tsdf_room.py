@@ -24,8 +24,8 @@ from sensor_msgs import point_cloud2
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Bool, Header
 from std_srvs.srv import Empty
-from visualization_msgs.msg import Marker, MarkerArray
 
+from downstream_perception.mesh_collector import MeshCollector
 from downstream_perception.ros_util import wait_until
 from downstream_perception.sim.depth_camera import room_scene
 from downstream_perception.srv import SaveMap
@@ -35,22 +35,9 @@ class TsdfRoomTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls) -> None:
         rospy.init_node("test_tsdf_room")
-        cls.blocks: dict[int, np.ndarray] = {}  # marker id -> (3 n, 3) triangle corners
-        cls.mesh_messages = 0
-        cls.deleted_all = False
+        cls.mesh = MeshCollector("/tsdf/mesh")
         cls.status: dict[str, str] = {}
         cls.done = False
-
-        def on_mesh(msg: MarkerArray) -> None:
-            for m in msg.markers:
-                if m.action == Marker.DELETEALL:
-                    cls.blocks.clear()
-                    cls.deleted_all = True
-                elif m.action == Marker.DELETE:
-                    cls.blocks.pop(m.id, None)
-                else:
-                    cls.blocks[m.id] = np.array([[p.x, p.y, p.z] for p in m.points])
-            cls.mesh_messages += 1
 
         def on_diag(msg: DiagnosticArray) -> None:
             for s in msg.status:
@@ -71,7 +58,6 @@ class TsdfRoomTest(unittest.TestCase):
             cls.slice = msg
 
         rospy.Subscriber("/tsdf/slice", OccupancyGrid, on_slice, queue_size=1)
-        rospy.Subscriber("/tsdf/mesh", MarkerArray, on_mesh, queue_size=20)
         rospy.Subscriber("/tsdf/octomap_occupied", PointCloud2, on_octomap, queue_size=1)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
@@ -79,10 +65,10 @@ class TsdfRoomTest(unittest.TestCase):
     def test_1_mesh_lies_on_the_true_surfaces(self) -> None:
         self.assertTrue(wait_until(lambda: self.done, 40.0), "the simulator did not finish")
         time.sleep(1.5)  # the next mesh update (2 Hz) after the last frame
-        self.assertGreater(self.mesh_messages, 0)
+        self.assertGreater(self.mesh.messages, 0)
         self.assertEqual(int(self.status.get("frames integrated", 0)), 20, self.status)
         self.assertGreater(int(self.status.get("health: zero crossings", 0)), 1000, self.status)
-        corners = np.vstack(list(self.blocks.values()))
+        corners = self.mesh.corners()
         self.assertGreater(len(corners), 30000)
         error = np.abs(room_scene().signed_distance(corners))
         # 4 cm voxels: sub-voxel surfaces (the 320x240 2 cm figures are 0.7 mm mean).
@@ -220,7 +206,7 @@ class TsdfRoomTest(unittest.TestCase):
     def test_4_clear_empties_the_map(self) -> None:
         rospy.wait_for_service("/tsdf/clear", 5.0)
         rospy.ServiceProxy("/tsdf/clear", Empty)()
-        self.assertTrue(wait_until(lambda: self.deleted_all, 5.0), "DELETEALL marker")
+        self.assertTrue(wait_until(lambda: self.mesh.deleted_all, 5.0), "DELETEALL marker")
         self.assertTrue(wait_until(lambda: int(self.status.get("blocks", -1)) == 0, 5.0))
         self.assertTrue(wait_until(lambda: int(self.status.get("octomap: leaves", -1)) == 0, 5.0))
 
