@@ -560,6 +560,7 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("slice: occupied cells", slice_stats_.cells_occupied);
   status.add("slice band (m)", toText(slice_.min_z_m) + " .. " + toText(slice_.max_z_m));
   status.add("max_weight", map_->config().max_weight);
+  status.add("free-space carving", map_->config().carve_free_space ? "on" : "off");
   status.add("depth range (m)",
              toText(map_->config().min_depth_m) + " .. " + toText(map_->config().max_depth_m));
   if (octree_) {

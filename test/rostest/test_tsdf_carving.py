@@ -66,6 +66,8 @@ class TsdfCarvingTest(unittest.TestCase):
             counts[name] = int(np.sum((on_box < 0.02) & (corners[:, 2] > 0.1)))  # above the floor
         self.assertGreater(counts["plain"], 200, counts)  # the box stays without carving
         self.assertLess(counts["carving"], 10, counts)  # and is gone with it
+        self.assertEqual(self.status["tsdf_carving"]["free-space carving"], "on")
+        self.assertEqual(self.status["tsdf_plain"]["free-space carving"], "off")
         blocks = {n: int(self.status[n]["blocks"]) for n in ("tsdf_carving", "tsdf_plain")}
         self.assertGreater(blocks["tsdf_carving"], blocks["tsdf_plain"], blocks)
 
