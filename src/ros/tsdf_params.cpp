@@ -2,7 +2,18 @@
 
 namespace downstream_perception {
 
-TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, std::vector<std::string>* errors) {
+std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c) {
+  if (max_blocks < 1) return "max_blocks must be >= 1, got " + std::to_string(max_blocks);
+  if (weighting != "constant" && weighting != "inverse_square_depth") {
+    return "weighting must be 'constant' or 'inverse_square_depth', got '" + weighting + "'";
+  }
+  c->max_blocks = static_cast<std::size_t>(max_blocks);
+  c->weighting = weighting == "constant" ? TsdfConfig::Weighting::kConstant
+                                         : TsdfConfig::Weighting::kInverseSquareDepth;
+  return {};
+}
+
+TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   TsdfConfig c;
   pnh.param("voxel_size_m", c.voxel_size_m, c.voxel_size_m);
   pnh.param("truncation_voxels", c.truncation_voxels, c.truncation_voxels);
@@ -20,19 +31,10 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, std::vector<std::string>* 
   std::string weighting = "constant";
   pnh.param("weighting", weighting, weighting);
 
-  std::string why;
-  if (max_blocks < 1) {
-    why = "max_blocks must be >= 1, got " + std::to_string(max_blocks);
-  } else if (weighting != "constant" && weighting != "inverse_square_depth") {
-    why = "weighting must be 'constant' or 'inverse_square_depth', got '" + weighting + "'";
-  } else {
-    c.max_blocks = static_cast<std::size_t>(max_blocks);
-    c.weighting = weighting == "constant" ? TsdfConfig::Weighting::kConstant
-                                          : TsdfConfig::Weighting::kInverseSquareDepth;
-    why = c.validate();
-  }
+  std::string why = setNamedTsdfSettings(weighting, max_blocks, &c);
+  if (why.empty()) why = c.validate();
   if (why.empty()) return c;
-  errors->push_back("invalid TSDF parameters (" + why + "); using the defaults");
+  errors->add("invalid TSDF parameters (" + why + "); using the defaults");
   return TsdfConfig{};
 }
 

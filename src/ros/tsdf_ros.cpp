@@ -146,9 +146,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     config_errors_.add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
     tf_queue_size = 10;
   }
-  std::vector<std::string> tsdf_errors;
-  map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &tsdf_errors));
-  for (const std::string& e : tsdf_errors) config_errors_.add(e);
+  map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
   OctreeConfig octree;
   pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
   pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
@@ -234,16 +232,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.max_depth_m = cfg.max_depth_m;
   next.min_weight = cfg.min_weight;
   next.max_block_distance_m = cfg.max_block_distance_m;
-  std::string why;
-  if (cfg.max_blocks < 1) {
-    why = "max_blocks must be >= 1, got " + std::to_string(cfg.max_blocks);
-  } else if (cfg.weighting != "constant" && cfg.weighting != "inverse_square_depth") {
-    why = "weighting must be 'constant' or 'inverse_square_depth', got '" + cfg.weighting + "'";
-  }
-  next.max_blocks = static_cast<std::size_t>(std::max(1, cfg.max_blocks));
-  next.weighting = cfg.weighting == "inverse_square_depth"
-                       ? TsdfConfig::Weighting::kInverseSquareDepth
-                       : TsdfConfig::Weighting::kConstant;
+  std::string why = setNamedTsdfSettings(cfg.weighting, cfg.max_blocks, &next);
   TsdfSliceConfig next_slice = slice;
   next_slice.min_z_m = cfg.slice_min_z_m;
   next_slice.max_z_m = cfg.slice_max_z_m;

@@ -62,6 +62,7 @@ void OctreeWorker::run() {
     lock.unlock();
     double ms = 0.0;
     std::size_t leaves = 0, memory_bytes = 0;
+    bool counted = false;
     {
       std::lock_guard<std::mutex> tree_lock(tree_mutex_);
       const auto t0 = std::chrono::steady_clock::now();
@@ -71,16 +72,28 @@ void OctreeWorker::run() {
         tree_.insertDepth(o.depth.data(), o.camera, o.pose);
       }
       ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      leaves = tree_.leafCount();
-      memory_bytes = tree_.memoryBytes();
+      // Counting walks the tree twice (about 4 ms for 56,000 leaves, a tenth of an insertion):
+      // skipped while observations wait, when the thread's time matters.
+      bool backlog;
+      {
+        std::lock_guard<std::mutex> queue_lock(queue_mutex_);  // order: tree, then queue
+        backlog = !queue_.empty();
+      }
+      if (!backlog) {
+        leaves = tree_.leafCount();
+        memory_bytes = tree_.memoryBytes();
+        counted = true;
+      }
     }
     lock.lock();
     busy_ = false;
     changed_ = true;
     ++stats_.inserted;
     stats_.insert_ms.add(ms);
-    stats_.leaves = leaves;
-    stats_.memory_bytes = memory_bytes;
+    if (counted) {
+      stats_.leaves = leaves;
+      stats_.memory_bytes = memory_bytes;
+    }
     if (queue_.empty()) idle_.notify_all();
   }
 }

@@ -30,11 +30,17 @@ std::string TsdfConfig::validate() const {
   return why.str();
 }
 
-TsdfMap::TsdfMap(const TsdfConfig& config) : config_(config) {
+namespace {
+/// The cap fuse() applies: max_weight, or none (+Inf) for 0.
+float weightCapOf(const TsdfConfig& c) {
+  return c.max_weight > 0.0 ? static_cast<float>(c.max_weight)
+                            : std::numeric_limits<float>::infinity();
+}
+}  // namespace
+
+TsdfMap::TsdfMap(const TsdfConfig& config) : config_(config), weight_cap_(weightCapOf(config)) {
   const std::string why = config.validate();
   if (!why.empty()) throw std::invalid_argument("tsdf: " + why);
-  weight_cap_ = config.max_weight > 0.0 ? static_cast<float>(config.max_weight)
-                                        : std::numeric_limits<float>::infinity();
 }
 
 std::string TsdfMap::setConfig(const TsdfConfig& config) {
@@ -46,8 +52,7 @@ std::string TsdfMap::setConfig(const TsdfConfig& config) {
            "are in their units); restart the node to change them";
   }
   config_ = config;
-  weight_cap_ = config.max_weight > 0.0 ? static_cast<float>(config.max_weight)
-                                        : std::numeric_limits<float>::infinity();
+  weight_cap_ = weightCapOf(config);
   return {};
 }
 

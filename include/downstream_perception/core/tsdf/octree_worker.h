@@ -29,8 +29,8 @@ class OctreeWorker {
     std::size_t dropped = 0;  ///< pushed out of a full queue, never inserted
     std::size_t waiting = 0;
     RunningStats insert_ms;
-    /// The tree's size after the last insertion or clearing (counting walks the tree, so the
-    /// worker does it, not the caller).
+    /// The tree's size after the last insertion that left no observation waiting, or after a
+    /// clearing (counting walks the tree, so the worker does it, not the caller).
     std::size_t leaves = 0;
     std::size_t memory_bytes = 0;
   };
