@@ -39,10 +39,11 @@ class ObservationWeight {
         s_(static_cast<float>(c.voxel_size_m)),
         mu_(mu),
         inv_dropoff_span_(1.0f / (mu - s_)) {}
+  /// Branch-free (selects only), so a loop calling it vectorises.
   float operator()(float z, float sdf) const {
-    float w = inverse_square_ ? 1.0f / (z * z) : 1.0f;
-    if (dropoff_ && sdf < -s_) w *= (mu_ + sdf) * inv_dropoff_span_;
-    return w;
+    const float w = inverse_square_ ? 1.0f / (z * z) : 1.0f;
+    const float dropped = w * ((mu_ + sdf) * inv_dropoff_span_);
+    return dropoff_ & (sdf < -s_) ? dropped : w;
   }
 
  private:
@@ -71,6 +72,7 @@ DP_INTEGRATION_STEP Eigen::Vector3i blockOfPoint(const Eigen::Vector3d& p, doubl
 // element, so frames of one size allocate and zero nothing.
 struct DepthFrame {
   std::vector<float> depth;
+  /// Padded by w + 1 pixels, so the 2 x 2 pixels from any pixel can be read.
   std::vector<float> inverse;
   /// |(x/z, y/z, 1)| of each pixel's ray; depends on the intrinsics only, so recomputed only
   /// when they change.
@@ -175,7 +177,7 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   const std::size_t n = static_cast<std::size_t>(w) * h;
   computeRangePerDepth(camera, &f);
   f.depth.resize(n);
-  f.inverse.resize(n);
+  f.inverse.resize(n + w + 1);
   // Branch-free classification (vectorised): NaN, 0, negatives and out-of-range depths fail
   // both compares.
   const float min_d = static_cast<float>(c.min_depth_m), max_d = static_cast<float>(c.max_depth_m);
@@ -236,32 +238,19 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   }
 }
 
-/// Depth at a sub-pixel position: inverse depth interpolated bilinearly between the four
-/// surrounding pixel centres (exact on planes, where 1/z is affine in the image), or `nearest`
-/// when a neighbour is not a valid depth or the four differ by more than the voxel size (a depth
-/// edge: interpolating there would put surface in free space; DepthFrame::smooth).
-DP_INTEGRATION_STEP float interpolatedDepth(const DepthFrame& f, int w, float uf, float vf,
-                                            float nearest) {
-  if (uf < 0.0f || vf < 0.0f) return nearest;
-  const int u0 = static_cast<int>(uf);
-  const int v0 = static_cast<int>(vf);
-  const std::size_t i = static_cast<std::size_t>(v0) * w + u0;
-  if (!f.smooth[i]) return nearest;  // also 0 in the last row and column
-  const float* inv = f.inverse.data() + i;
-  const float a = uf - static_cast<float>(u0), b = vf - static_cast<float>(v0);
-  return 1.0f / ((1.0f - b) * ((1.0f - a) * inv[0] + a * inv[1]) +
-                 b * ((1.0f - a) * inv[w] + a * inv[w + 1]));
-}
-
 /// Blocks the truncation band of the valid pixels passes through (with carve_free_space, the
 /// whole ray from the sensor, and the rays of +Inf pixels up to max_depth_m). Pixels are sampled
 /// every `stride` pixels, where a stride spans at most one voxel at the nearest depth of the
 /// frame (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the
-/// same block, so a one-entry cache per sample along the ray skips most hash lookups.
-DP_INTEGRATION_STEP tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(
-    const DepthFrame& f, const PinholeCamera& camera, const Eigen::Isometry3d& T,
-    const TsdfConfig& c) {
-  tsl::robin_set<Eigen::Vector3i, BlockIndexHash> keys;
+/// same block, so a one-entry cache per sample along the ray skips most hash lookups. The
+/// blocks are listed in the order the image's rows first reach them, so consecutive blocks read
+/// nearby pixels (hash order would scatter the integration's pixel reads over the whole image).
+DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
+                                                            const PinholeCamera& camera,
+                                                            const Eigen::Isometry3d& T,
+                                                            const TsdfConfig& c) {
+  tsl::robin_set<Eigen::Vector3i, BlockIndexHash> seen;
+  std::vector<Eigen::Vector3i> keys;
   // Without a valid depth only carving (along +Inf rays) has anything to do.
   if (!std::isfinite(f.min_depth) && !c.carve_free_space) return keys;
   const double s = c.voxel_size_m;
@@ -310,7 +299,7 @@ DP_INTEGRATION_STEP tsl::robin_set<Eigen::Vector3i, BlockIndexHash> bandBlocks(
         const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), 1.0 / s);
         if (key == last[k]) continue;
         last[k] = key;
-        keys.insert(key);
+        if (seen.insert(key).second) keys.push_back(key);
       }
     }
   }
@@ -352,7 +341,9 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   const DepthFrame& frame = *scratch;
   const auto keys = bandBlocks(frame, camera, T_map_camera, c);
 
-  // Every voxel of those blocks: project to the nearest pixel centre, fuse.
+  // Every voxel of those blocks, a row of eight at a time, in three passes: project (vectorised),
+  // load the pixel data each voxel needs (scalar loads), fuse (vectorised and branch-free, so
+  // its two divisions run eight voxels at once and no data-dependent branch mispredicts).
   const float max_step = static_cast<float>(s);
   const Eigen::Isometry3d T_camera_map = T_map_camera.inverse();
   // The voxel loop runs in float (voxel positions relative to the camera, within max_depth_m:
@@ -369,6 +360,19 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   const bool interpolate = c.interpolate_depth;
   const ObservationWeight weight(c, muf);
   const float inv_mu = 1.0f / muf;
+  const bool guard = !frame.near_edge.empty();
+  const float* depth_px = frame.depth.data();
+  const float* range_px = frame.range_per_depth.data();
+  const float* inverse_px = frame.inverse.data();
+  const std::uint8_t* edge_px = frame.near_edge.data();
+  const std::uint8_t* smooth_px = frame.smooth.data();
+  // Pass 2's per-voxel pixel data. A row writes only what its pass 3 uses (voxels in view and
+  // not behind the band; the interpolation inputs only in the band); the rest keeps an earlier
+  // row's finite values, which pass 3's selects discard.
+  alignas(32) float nearest[kTsdfBlockSide] = {}, range[kTsdfBlockSide] = {};
+  alignas(32) float i00[kTsdfBlockSide] = {}, i10[kTsdfBlockSide] = {}, i01[kTsdfBlockSide] = {},
+                    i11[kTsdfBlockSide] = {};
+  alignas(32) int flags[kTsdfBlockSide] = {};  // bit 0: interpolate, bit 1: near an edge
   for (const Eigen::Vector3i& key : keys) {
     const bool existed = map->find(key) != nullptr;
     TsdfBlock* block = map->allocate(key);
@@ -385,11 +389,11 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
       for (int y = 0; y < kTsdfBlockSide; ++y) {
         const Eigen::Vector3f row = base + dz * static_cast<float>(z) + dy * static_cast<float>(y);
         // Pass 1, the row's eight projections at once (plain loops the compiler vectorises):
-        // depth along the axis, the pixel coordinates shifted by half a pixel (so truncation is
-        // rounding to the nearest pixel centre: no half-pixel bias) and the pixel, or -1 when
-        // the voxel is too close or outside the image.
-        alignas(32) float zc[kTsdfBlockSide], us[kTsdfBlockSide], vs[kTsdfBlockSide];
-        alignas(32) int column[kTsdfBlockSide], line[kTsdfBlockSide];
+        // depth along the axis; the nearest pixel (coordinates shifted by half a pixel, so
+        // truncation rounds to the nearest pixel centre: no half-pixel bias), or -1 when the
+        // voxel is too close or outside the image; the 2 x 2 pixels around it for interpolation.
+        alignas(32) float zc[kTsdfBlockSide], frac_u[kTsdfBlockSide], frac_v[kTsdfBlockSide];
+        alignas(32) int pixel[kTsdfBlockSide], cell[kTsdfBlockSide], corners_ok[kTsdfBlockSide];
         int in_view = 0;
         for (int x = 0; x < kTsdfBlockSide; ++x) {
           const float fxv = static_cast<float>(x);
@@ -400,43 +404,82 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
           const float u = fx * px * inv_z + cx;
           const float v = fy * py * inv_z + cy;
           const bool ok = (pz >= min_z) & (u >= 0.0f) & (v >= 0.0f) & (u < u_end) & (v < v_end);
+          const float us = ok ? u : 0.0f, vs = ok ? v : 0.0f;
           zc[x] = pz;
-          us[x] = ok ? u : 0.0f;
-          vs[x] = ok ? v : 0.0f;
-          column[x] = ok ? static_cast<int>(us[x]) : -1;
-          line[x] = static_cast<int>(vs[x]);
+          pixel[x] = ok ? static_cast<int>(vs) * w + static_cast<int>(us) : -1;
+          // The 2 x 2 pixel centres around the projection, for interpolation: us - 0.5 >= -0.5,
+          // so its integer part is a pixel (the inverse-depth table is padded for the last).
+          const float uf = us - 0.5f, vf = vs - 0.5f;
+          const int u0 = static_cast<int>(uf), v0 = static_cast<int>(vf);
+          frac_u[x] = uf - static_cast<float>(u0);
+          frac_v[x] = vf - static_cast<float>(v0);
+          cell[x] = v0 * w + u0;
+          corners_ok[x] = (uf >= 0.0f) & (vf >= 0.0f);
           in_view |= ok;
         }
         if (!in_view) continue;
-        TsdfVoxel* row_voxels = &block->voxels[TsdfBlock::linear(0, y, z)];
-        // Pass 2, per voxel: the depth it sees and the fusion.
+        // Pass 2, per voxel: the pixel data it needs, by scalar loads (AVX2's gathers are
+        // slower than scalar loads on AMD Zen 2). Interpolation moves the depth by at most
+        // max_step, hence the band's margins.
+        bool any_update = false;
         for (int x = 0; x < kTsdfBlockSide; ++x) {
-          if (column[x] < 0) continue;
-          const std::size_t px = static_cast<std::size_t>(line[x] * w + column[x]);
-          const float nearest = frame.depth[px];
-          // One test drops both invalid pixels (NaN) and voxels clearly behind the band;
-          // +Inf (no return within range) passes it as free space along the whole ray.
-          // Interpolation moves the depth by at most max_step, hence the margins.
-          const float along_axis = nearest - zc[x];
-          if (!(along_axis >= -muf - max_step)) continue;
-          float sdf = muf;
-          if (nearest > max_z) {
-            if (zc[x] > max_z) continue;  // no return: free only up to max_depth_m
-          } else if (along_axis <= muf + max_step) {
-            // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table.
-            const float d = interpolate
-                                ? interpolatedDepth(frame, w, us[x] - 0.5f, vs[x] - 0.5f, nearest)
-                                : nearest;
-            sdf = (d - zc[x]) * frame.range_per_depth[px];
-            if (sdf < -muf) continue;
-            // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
-            if (sdf < -sf && !frame.near_edge.empty() && frame.near_edge[px]) continue;
+          if (pixel[x] < 0) continue;
+          const std::size_t px = static_cast<std::size_t>(pixel[x]);
+          nearest[x] = depth_px[px];
+          const float along_axis = nearest[x] - zc[x];
+          if (!(along_axis >= -muf - max_step)) continue;  // behind the band, or NaN
+          any_update = true;
+          if (!(along_axis <= muf + max_step)) continue;  // in front: free space
+          range[x] = range_px[px];
+          int flag = guard ? edge_px[px] << 1 : 0;
+          if (interpolate) {
+            const float* inv = inverse_px + cell[x];
+            i00[x] = inv[0];
+            i10[x] = inv[1];
+            i01[x] = inv[w];
+            i11[x] = inv[w + 1];
+            flag |= corners_ok[x] & smooth_px[cell[x]];
           }
-          const float dn = std::min(1.0f, sdf * inv_mu);
-          map->fuse(row_voxels + x, dn, weight(nearest > max_z ? zc[x] : nearest, sdf));
-          ++stats.voxels_updated;
-          touched = true;
+          flags[x] = flag;
         }
+        if (!any_update) continue;
+        // Pass 3, the row's eight fusions at once (a plain loop the compiler vectorises; a
+        // voxel that is not updated keeps its value through the selects).
+        TsdfVoxel* row_voxels = &block->voxels[TsdfBlock::linear(0, y, z)];
+        int updated = 0;
+        for (int x = 0; x < kTsdfBlockSide; ++x) {
+          const float z_axis = zc[x];
+          // Invalid pixels (NaN) and voxels clearly behind the band are not updated; +Inf (no
+          // return within range) is free space along the whole ray.
+          const float along_axis = nearest[x] - z_axis;
+          const bool no_return = nearest[x] > max_z;
+          const bool in_band = !no_return & (along_axis <= muf + max_step);
+          // Inverse depth interpolated bilinearly between the four surrounding pixel centres
+          // (exact on planes, where 1/z is affine in the image), or the nearest pixel's depth
+          // next to a depth edge or an invalid pixel (DepthFrame::smooth) and at the image's
+          // first half pixel.
+          const float a = frac_u[x], b = frac_v[x];
+          const float interpolated = 1.0f / ((1.0f - b) * ((1.0f - a) * i00[x] + a * i10[x]) +
+                                             b * ((1.0f - a) * i01[x] + a * i11[x]));
+          const float d = (flags[x] & 1) ? interpolated : nearest[x];
+          // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table.
+          const float sdf = in_band ? (d - z_axis) * range[x] : muf;
+          const bool update =
+              (pixel[x] >= 0) & (along_axis >= -muf - max_step) &
+              !(no_return & (z_axis > max_z)) &  // no return: free only up to max_depth_m
+              !(in_band & (sdf < -muf)) &
+              // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
+              !(in_band & (sdf < -sf) & ((flags[x] & 2) != 0));
+          const float dn = std::min(1.0f, sdf * inv_mu);
+          const float obs_w = weight(no_return ? z_axis : nearest[x], sdf);
+          TsdfVoxel& voxel = row_voxels[x];
+          const TsdfVoxel fused = map->fused(voxel, dn, obs_w);
+          voxel.distance = update ? fused.distance : voxel.distance;
+          voxel.weight = update ? fused.weight : voxel.weight;
+          updated += update;
+        }
+        stats.voxels_updated += updated;
+        touched |= updated != 0;
       }
     }
     if (touched) block->updated_stamp = generation;

@@ -119,12 +119,14 @@ class TsdfMap {
   /// The voxel if its block exists, else nullptr.
   const TsdfVoxel* voxel(const Eigen::Vector3i& voxel) const;
 
-  /// Fuses one observation (normalised distance d, weight w) into a voxel.
-  void fuse(TsdfVoxel* v, float d, float w) const {
-    const float total = v->weight + w;
-    v->distance = (v->weight * v->distance + w * d) / total;
-    v->weight = std::min(total, weight_cap_);
+  /// Voxel v after fusing one observation (normalised distance d, weight w). A plain function
+  /// of values, so the integrator's loop over a row of voxels vectorises.
+  TsdfVoxel fused(const TsdfVoxel& v, float d, float w) const {
+    const float total = v.weight + w;
+    return {(v.weight * v.distance + w * d) / total, std::min(total, weight_cap_)};
   }
+  /// Fuses one observation (normalised distance d, weight w) into a voxel.
+  void fuse(TsdfVoxel* v, float d, float w) const { *v = fused(*v, d, w); }
 
   /// Removes blocks whose centre is farther than `distance_m` from `center`; returns how many.
   std::size_t evictFartherThan(const Eigen::Vector3d& center, double distance_m);
