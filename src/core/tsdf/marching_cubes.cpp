@@ -158,25 +158,42 @@ bool gather(const TsdfMap& map, const Eigen::Vector3i& block, float min_weight, 
     *local = a - *offset * kTsdfBlockSide;
   };
   const float missing = std::numeric_limits<float>::quiet_NaN();
-  bool negative = false, non_negative = false;
+  const auto observedDistance = [&](const TsdfBlock* b, int x, int y, int z) {
+    if (b == nullptr) return missing;
+    const TsdfVoxel& v = b->voxels[TsdfBlock::linear(x, y, z)];
+    return v.weight > min_weight ? v.distance : missing;
+  };
+  // Row by row (x = -1 .. 9): one voxel from the block on the left, the centre block's eight
+  // (a plain loop the compiler vectorises), two from the block on the right.
   for (int z = -1; z <= kTsdfBlockSide + 1; ++z) {
     int oz, lz;
     split(z, &oz, &lz);
     for (int y = -1; y <= kTsdfBlockSide + 1; ++y) {
       int oy, ly;
       split(y, &oy, &ly);
-      const bool corner_yz = z >= 0 && y >= 0 && z <= kTsdfBlockSide && y <= kTsdfBlockSide;
-      for (int x = -1; x <= kTsdfBlockSide + 1; ++x) {
-        int ox, lx;
-        split(x, &ox, &lx);
-        const TsdfBlock* b = around[(ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1))];
-        const TsdfVoxel* v = b == nullptr ? nullptr : &b->voxels[TsdfBlock::linear(lx, ly, lz)];
-        const float d = v != nullptr && v->weight > min_weight ? v->distance : missing;
-        n->distance[Neighbourhood::at(x, y, z)] = d;
-        if (corner_yz && x >= 0 && x <= kTsdfBlockSide) {
-          negative |= d < 0.0f;
-          non_negative |= d >= 0.0f;  // NaN is neither
+      const int row_blocks = 3 * ((oy + 1) + 3 * (oz + 1));
+      float* out = &n->distance[Neighbourhood::at(-1, y, z)];
+      out[0] = observedDistance(around[row_blocks], kTsdfBlockSide - 1, ly, lz);
+      const TsdfBlock* centre = around[row_blocks + 1];
+      if (centre != nullptr) {
+        const TsdfVoxel* v = &centre->voxels[TsdfBlock::linear(0, ly, lz)];
+        for (int x = 0; x < kTsdfBlockSide; ++x) {
+          out[1 + x] = v[x].weight > min_weight ? v[x].distance : missing;
         }
+      } else {
+        std::fill(out + 1, out + 1 + kTsdfBlockSide, missing);
+      }
+      out[kTsdfBlockSide + 1] = observedDistance(around[row_blocks + 2], 0, ly, lz);
+      out[kTsdfBlockSide + 2] = observedDistance(around[row_blocks + 2], 1, ly, lz);
+    }
+  }
+  bool negative = false, non_negative = false;
+  for (int z = 0; z <= kTsdfBlockSide; ++z) {
+    for (int y = 0; y <= kTsdfBlockSide; ++y) {
+      const float* row = &n->distance[Neighbourhood::at(0, y, z)];
+      for (int x = 0; x <= kTsdfBlockSide; ++x) {
+        negative |= row[x] < 0.0f;
+        non_negative |= row[x] >= 0.0f;  // NaN is neither
       }
     }
   }
@@ -260,17 +277,36 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
   const Eigen::Vector3i origin = block * kTsdfBlockSide;
   for (int z = 0; z < kTsdfBlockSide; ++z) {
     for (int y = 0; y < kTsdfBlockSide; ++y) {
+      // The row's eight cubes classified at once (a plain loop the compiler vectorises): the
+      // inside mask of their corners (bit c: corner c negative), or 0 when a corner is
+      // unobserved. Corner c of cube x lies in row (y + o[1], z + o[2]) at x + o[0].
+      const float* r00 = &n.distance[Neighbourhood::at(0, y, z)];
+      const float* r10 = &n.distance[Neighbourhood::at(0, y + 1, z)];
+      const float* r01 = &n.distance[Neighbourhood::at(0, y, z + 1)];
+      const float* r11 = &n.distance[Neighbourhood::at(0, y + 1, z + 1)];
+      std::array<int, kTsdfBlockSide> masks;
+      int any = 0;
       for (int x = 0; x < kTsdfBlockSide; ++x) {
-        std::array<float, 8> corner;
+        const float c[8] = {r00[x], r00[x + 1], r10[x + 1], r10[x],
+                            r01[x], r01[x + 1], r11[x + 1], r11[x]};
         int mask = 0;
         bool complete = true;
+        for (int k = 0; k < 8; ++k) {
+          mask |= (c[k] < 0.0f) << k;
+          complete &= observed(c[k]);
+        }
+        masks[x] = complete && mask != 255 ? mask : 0;
+        any |= masks[x];
+      }
+      if (any == 0) continue;
+      for (int x = 0; x < kTsdfBlockSide; ++x) {
+        const int mask = masks[x];
+        if (mask == 0) continue;
+        std::array<float, 8> corner;
         for (int c = 0; c < 8; ++c) {
           const auto& o = kCubeCorners[c];
           corner[c] = n(x + o[0], y + o[1], z + o[2]);
-          complete &= observed(corner[c]);
-          mask |= (corner[c] < 0.0f) << c;
         }
-        if (!complete || mask == 0 || mask == 255) continue;
         for (const auto& tri : marchingCubesCase(mask)) {
           std::array<std::uint32_t, 3> ids;
           for (int k = 0; k < 3; ++k) {
