@@ -361,14 +361,15 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   const ObservationWeight weight(c, muf);
   const float inv_mu = 1.0f / muf;
   const bool guard = !frame.near_edge.empty();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
   const float* depth_px = frame.depth.data();
   const float* range_px = frame.range_per_depth.data();
   const float* inverse_px = frame.inverse.data();
   const std::uint8_t* edge_px = frame.near_edge.data();
   const std::uint8_t* smooth_px = frame.smooth.data();
-  // Pass 2's per-voxel pixel data. A row writes only what its pass 3 uses (voxels in view and
-  // not behind the band; the interpolation inputs only in the band); the rest keeps an earlier
-  // row's finite values, which pass 3's selects discard.
+  // Pass 2's per-voxel pixel data. A row writes the nearest depth of all eight voxels and the
+  // rest only for voxels in the band; the others keep an earlier row's finite values, which
+  // pass 3's selects discard.
   alignas(32) float nearest[kTsdfBlockSide] = {}, range[kTsdfBlockSide] = {};
   alignas(32) float i00[kTsdfBlockSide] = {}, i10[kTsdfBlockSide] = {}, i01[kTsdfBlockSide] = {},
                     i11[kTsdfBlockSide] = {};
@@ -389,9 +390,10 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
       for (int y = 0; y < kTsdfBlockSide; ++y) {
         const Eigen::Vector3f row = base + dz * static_cast<float>(z) + dy * static_cast<float>(y);
         // Pass 1, the row's eight projections at once (plain loops the compiler vectorises):
-        // depth along the axis; the nearest pixel (coordinates shifted by half a pixel, so
-        // truncation rounds to the nearest pixel centre: no half-pixel bias), or -1 when the
-        // voxel is too close or outside the image; the 2 x 2 pixels around it for interpolation.
+        // depth along the axis, NaN when the voxel is too close or outside the image (so no
+        // test below passes); the nearest pixel (coordinates shifted by half a pixel, so
+        // truncation rounds to the nearest pixel centre: no half-pixel bias); the 2 x 2 pixels
+        // around it for interpolation.
         alignas(32) float zc[kTsdfBlockSide], frac_u[kTsdfBlockSide], frac_v[kTsdfBlockSide];
         alignas(32) int pixel[kTsdfBlockSide], cell[kTsdfBlockSide], corners_ok[kTsdfBlockSide];
         int in_view = 0;
@@ -405,8 +407,8 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
           const float v = fy * py * inv_z + cy;
           const bool ok = (pz >= min_z) & (u >= 0.0f) & (v >= 0.0f) & (u < u_end) & (v < v_end);
           const float us = ok ? u : 0.0f, vs = ok ? v : 0.0f;
-          zc[x] = pz;
-          pixel[x] = ok ? static_cast<int>(vs) * w + static_cast<int>(us) : -1;
+          zc[x] = ok ? pz : nan;  // NaN: never updated
+          pixel[x] = ok ? static_cast<int>(vs) * w + static_cast<int>(us) : 0;
           // The 2 x 2 pixel centres around the projection, for interpolation: us - 0.5 >= -0.5,
           // so its integer part is a pixel (the inverse-depth table is padded for the last).
           const float uf = us - 0.5f, vf = vs - 0.5f;
@@ -423,7 +425,6 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
         // max_step, hence the band's margins.
         bool any_update = false;
         for (int x = 0; x < kTsdfBlockSide; ++x) {
-          if (pixel[x] < 0) continue;
           const std::size_t px = static_cast<std::size_t>(pixel[x]);
           nearest[x] = depth_px[px];
           const float along_axis = nearest[x] - zc[x];
@@ -465,7 +466,7 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
           // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table.
           const float sdf = in_band ? (d - z_axis) * range[x] : muf;
           const bool update =
-              (pixel[x] >= 0) & (along_axis >= -muf - max_step) &
+              (along_axis >= -muf - max_step) &
               !(no_return & (z_axis > max_z)) &  // no return: free only up to max_depth_m
               !(in_band & (sdf < -muf)) &
               // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
