@@ -374,14 +374,21 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   alignas(32) float i00[kTsdfBlockSide] = {}, i10[kTsdfBlockSide] = {}, i01[kTsdfBlockSide] = {},
                     i11[kTsdfBlockSide] = {};
   alignas(32) int flags[kTsdfBlockSide] = {};  // bit 0: interpolate, bit 1: near an edge
-  for (const Eigen::Vector3i& key : keys) {
-    const bool existed = map->find(key) != nullptr;
-    TsdfBlock* block = map->allocate(key);
-    if (block == nullptr) {
-      ++stats.blocks_refused;
-      continue;
-    }
-    stats.blocks_allocated += !existed;
+  // The blocks are found (or allocated) first, so each block's integration can prefetch the
+  // next block's voxels: blocks lie scattered in memory, where the hardware prefetcher does not
+  // follow.
+  std::vector<TsdfBlock*> blocks(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const bool existed = map->find(keys[i]) != nullptr;
+    blocks[i] = map->allocate(keys[i]);
+    stats.blocks_allocated += !existed && blocks[i] != nullptr;
+    stats.blocks_refused += blocks[i] == nullptr;
+  }
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const Eigen::Vector3i& key = keys[i];
+    TsdfBlock* block = blocks[i];
+    if (block == nullptr) continue;
+    const TsdfBlock* next = i + 1 < keys.size() ? blocks[i + 1] : nullptr;
     ++stats.blocks_touched;
     bool touched = false;
     const Eigen::Vector3f base =
@@ -389,6 +396,7 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
     for (int z = 0; z < kTsdfBlockSide; ++z) {
       for (int y = 0; y < kTsdfBlockSide; ++y) {
         const Eigen::Vector3f row = base + dz * static_cast<float>(z) + dy * static_cast<float>(y);
+        if (next != nullptr) __builtin_prefetch(&next->voxels[TsdfBlock::linear(0, y, z)], 1);
         // Pass 1, the row's eight projections at once (plain loops the compiler vectorises):
         // depth along the axis, NaN when the voxel is too close or outside the image (so no
         // test below passes); the nearest pixel (coordinates shifted by half a pixel, so
