@@ -71,8 +71,6 @@ class TsdfRos {
       std::uint32_t queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
-  /// The height-band slice over the map's x-y extent (100 occupied, 0 free, -1 unknown).
-  nav_msgs::OccupancyGridPtr makeSlice(const std_msgs::Header& header);
   /// Centres of the OctoMap's occupied leaves as a PointCloud2 (x, y, z) for rviz.
   sensor_msgs::PointCloud2Ptr occupiedCloud(const std_msgs::Header& header);
   bool saveOctomap(SaveMap::Request& request, SaveMap::Response& response);
@@ -102,13 +100,15 @@ class TsdfRos {
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> cloud_filter_;
   ros::Publisher mesh_publisher_;
   ros::Publisher slice_publisher_;
+  ros::Publisher slice_distance_publisher_;  ///< not advertised when slice_distance_max_m is 0
   ros::Publisher octomap_publisher_;
   ros::ServiceServer save_octomap_service_;
   /// Inserts into the OctoMap on its own thread; null when ~octomap_resolution_m is 0.
   std::unique_ptr<OctreeWorker> octree_;
   std::atomic<std::size_t> octree_occupied_{0};  ///< set by the publishing timer
   TsdfSliceConfig slice_;
-  bool slice_changed_ = false;  ///< the band moved: re-slice at the next mesh tick
+  bool slice_changed_ = false;         ///< the band moved: re-slice at the next mesh tick
+  double slice_distance_max_m_ = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
   TsdfSliceStats slice_stats_;
   ros::ServiceServer save_service_;
   ros::ServiceServer clear_service_;

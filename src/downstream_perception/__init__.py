@@ -97,6 +97,7 @@ try:
         ray_cells,
         recent_cells,
         shortest_angular_distance,
+        slice_distance,
         solve_assignment,
         swept_polygon,
         uncertainty_radius,

@@ -320,4 +320,28 @@ void bindTsdf(py::module& m) {
         self.map.clear();
         self.mesher.clear();
       });
+
+  m.def(
+      "slice_distance",
+      [](py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> slice,
+         double resolution, double max_distance_m) {
+        if (slice.ndim() != 2) {
+          throw std::invalid_argument("slice_distance: slice must be 2-D [y, x], got " +
+                                      std::to_string(slice.ndim()) + "-D");
+        }
+        const GridGeometry grid(static_cast<int>(slice.shape(1)), static_cast<int>(slice.shape(0)),
+                                resolution, 0.0, 0.0);
+        std::vector<SliceCell> cells(static_cast<std::size_t>(slice.size()));
+        std::transform(slice.data(), slice.data() + slice.size(), cells.begin(), [](std::int8_t v) {
+          return v > 0 ? SliceCell::kOccupied : (v == 0 ? SliceCell::kFree : SliceCell::kUnknown);
+        });
+        const std::vector<float> distance = sliceDistance(cells, grid, max_distance_m);
+        py::array_t<float> out({slice.shape(0), slice.shape(1)});
+        std::copy(distance.begin(), distance.end(), out.mutable_data());
+        return out;
+      },
+      py::arg("slice"), py::arg("resolution"), py::arg("max_distance_m") = 2.0,
+      "Euclidean distance (m, float32 [y, x]) from each cell of a slice ([y, x]: > 0 occupied, "
+      "0 free, < 0 unknown; Tsdf.slice's output or an OccupancyGrid's data) to the nearest "
+      "occupied cell, capped at max_distance_m; NaN on unknown cells.");
 }

@@ -15,6 +15,7 @@
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/tf_failure.h"
 #include "downstream_perception/tsdf_params.h"
+#include "downstream_perception/tsdf_slice_messages.h"
 
 namespace downstream_perception {
 
@@ -140,6 +141,13 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     config_errors_.add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
     slice_ = TsdfSliceConfig{};
   }
+  pnh_.param("slice_distance_max_m", slice_distance_max_m_, slice_distance_max_m_);
+  if (!(std::isfinite(slice_distance_max_m_) && slice_distance_max_m_ >= 0.0 &&
+        slice_distance_max_m_ <= 100.0)) {
+    config_errors_.add("parameter ~slice_distance_max_m = " + toText(slice_distance_max_m_) +
+                       " must be in [0, 100] m (0 = off); using 2");
+    slice_distance_max_m_ = 2.0;
+  }
   int tf_queue_size = 10;
   pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
   if (tf_queue_size < 1 || tf_queue_size > 1000) {
@@ -169,6 +177,9 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
   slice_publisher_ = pnh_.advertise<nav_msgs::OccupancyGrid>("slice", 1, true);
+  if (slice_distance_max_m_ > 0.0) {
+    slice_distance_publisher_ = pnh_.advertise<sensor_msgs::PointCloud2>("slice_distance", 1, true);
+  }
   save_service_ = pnh_.advertiseService("save_mesh", &TsdfRos::saveMesh, this);
   if (octree_) {
     octomap_publisher_ = pnh_.advertise<sensor_msgs::PointCloud2>("octomap_occupied", 1, true);
@@ -408,6 +419,9 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
 void TsdfRos::publishMesh(const ros::TimerEvent&) {
   visualization_msgs::MarkerArray markers;
   nav_msgs::OccupancyGridPtr slice;
+  std::vector<SliceCell> slice_cells;
+  GridGeometry slice_geometry;
+  double slice_z = 0.0;
   sensor_msgs::PointCloud2Ptr occupied;
   std_msgs::Header header;
   header.frame_id = world_frame_;
@@ -420,7 +434,12 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     markers = markers_.changed(mesher_, header);
     if (!mesher_.lastUpdated().empty() || !markers.markers.empty() || slice_changed_) {
-      slice = makeSlice(header);
+      slice_geometry = sliceGeometry(*map_);
+      if (slice_geometry.sizeX() > 0) {
+        slice_cells = sliceTsdf(*map_, slice_geometry, slice_, &slice_stats_);
+      }
+      slice_z = slice_.min_z_m;
+      slice = sliceGridMessage(slice_cells, slice_geometry, slice_z, header);
       slice_changed_ = false;
     }
     mesh_triangles_ = 0;
@@ -438,6 +457,12 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   if (octree_ && octree_->takeChanged()) occupied = occupiedCloud(header);
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
   if (slice) slice_publisher_.publish(slice);
+  // The clearance map only while someone listens (latched: a late subscriber gets the next).
+  if (slice && slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
+    slice_distance_publisher_.publish(
+        sliceDistanceCloud(sliceDistance(slice_cells, slice_geometry, slice_distance_max_m_),
+                           slice_geometry, slice_z, header));
+  }
   if (occupied) octomap_publisher_.publish(occupied);
   diagnostics_.update();
 }
@@ -469,28 +494,6 @@ bool TsdfRos::saveOctomap(SaveMap::Request& request, SaveMap::Response& response
     });
   });
   return true;
-}
-
-nav_msgs::OccupancyGridPtr TsdfRos::makeSlice(const std_msgs::Header& header) {
-  nav_msgs::OccupancyGridPtr grid(new nav_msgs::OccupancyGrid);
-  grid->header = header;
-  const GridGeometry geometry = sliceGeometry(*map_);
-  grid->info.map_load_time = header.stamp;
-  grid->info.resolution = static_cast<float>(geometry.resolution());
-  grid->info.width = static_cast<std::uint32_t>(geometry.sizeX());
-  grid->info.height = static_cast<std::uint32_t>(geometry.sizeY());
-  grid->info.origin.position.x = geometry.originX();
-  grid->info.origin.position.y = geometry.originY();
-  grid->info.origin.position.z = slice_.min_z_m;
-  grid->info.origin.orientation.w = 1.0;
-  if (geometry.sizeX() == 0) return grid;
-  const std::vector<SliceCell> cells = sliceTsdf(*map_, geometry, slice_, &slice_stats_);
-  grid->data.resize(cells.size());
-  for (std::size_t i = 0; i < cells.size(); ++i) {
-    grid->data[i] =
-        cells[i] == SliceCell::kOccupied ? 100 : (cells[i] == SliceCell::kFree ? 0 : -1);
-  }
-  return grid;
 }
 
 bool TsdfRos::saveMesh(SaveMap::Request& request, SaveMap::Response& response) {
@@ -548,6 +551,8 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("mesh triangles", mesh_triangles_);
   status.add("slice: occupied cells", slice_stats_.cells_occupied);
   status.add("slice band (m)", toText(slice_.min_z_m) + " .. " + toText(slice_.max_z_m));
+  status.add("slice distance cap (m)",
+             slice_distance_max_m_ > 0.0 ? toText(slice_distance_max_m_) : std::string("off"));
   status.add("max_weight", map_->config().max_weight);
   status.add("free-space carving", map_->config().carve_free_space ? "on" : "off");
   status.add("depth range (m)",

@@ -632,6 +632,44 @@ TEST(TsdfSlice, TableTopInTheBandIsAnObstacleTheFloorIsNot) {
   EXPECT_THROW(sliceTsdf(map, grid, band), std::invalid_argument);
 }
 
+TEST(TsdfSlice, DistanceIsEuclideanToTheNearestOccupiedCell) {
+  // 0.1 m cells; occupied: one cell and a short wall; unknown: a block the distance may not
+  // report but must see through (it treats unknown as free).
+  const GridGeometry grid(30, 20, 0.1, -1.0, -1.0);
+  std::vector<SliceCell> cells(30 * 20, SliceCell::kFree);
+  std::vector<CellIndex> occupied = {{4, 5}};
+  for (int y = 10; y < 16; ++y) occupied.push_back({22, y});
+  for (const CellIndex& c : occupied) cells[grid.index(c.x, c.y)] = SliceCell::kOccupied;
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 10; x < 14; ++x) cells[grid.index(x, y)] = SliceCell::kUnknown;
+  }
+  const double cap = 1.25;
+  const std::vector<float> distance = sliceDistance(cells, grid, cap);
+  ASSERT_EQ(distance.size(), cells.size());
+  std::size_t capped = 0;
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 30; ++x) {
+      const float d = distance[grid.index(x, y)];
+      if (cells[grid.index(x, y)] == SliceCell::kUnknown) {
+        EXPECT_TRUE(std::isnan(d)) << x << ", " << y;
+        continue;
+      }
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const CellIndex& c : occupied) nearest = std::min(nearest, std::hypot(x - c.x, y - c.y));
+      const double expected = std::min(cap, 0.1 * nearest);
+      EXPECT_NEAR(d, expected, 1e-6) << x << ", " << y;
+      capped += expected == cap;
+    }
+  }
+  EXPECT_GT(capped, 10u);                               // the cap applies
+  EXPECT_NEAR(distance[grid.index(7, 9)], 0.5, 1e-6);   // (3, 4) cells from the single one
+  EXPECT_NEAR(distance[grid.index(12, 5)], 0.8, 1e-6);  // beside the unknown block
+  EXPECT_THROW(sliceDistance(cells, grid, -0.1), std::invalid_argument);
+  EXPECT_THROW(sliceDistance(cells, grid, std::nan("")), std::invalid_argument);
+  cells.pop_back();
+  EXPECT_THROW(sliceDistance(cells, grid, cap), std::invalid_argument);
+}
+
 TEST(TsdfHealth, CleanPlaneHasUnitGradientDriftDoublesTheSurface) {
   // A plane fused from consistent views: |grad (D mu)| = 1 at its crossings, no double crossing.
   // The same plane with half of the views shifted by 0.3 m along its normal (pose drift beyond

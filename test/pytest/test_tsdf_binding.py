@@ -269,6 +269,32 @@ def test_slice_puts_the_table_top_into_the_grid() -> None:
     assert above[int((table[1] + 2.5) / 0.05), int((table[0] + 2.5) / 0.05)] == 0
 
 
+def test_slice_distance_is_the_exact_euclidean_distance() -> None:
+    # The room's slice at 5 cm: the clearance map equals scipy's exact Euclidean distance
+    # transform of "not occupied", capped, with NaN where the slice is unknown.
+    from scipy.ndimage import distance_transform_edt
+
+    cam, _, poses, depths, _ = room_frames("qvga")
+    config = dp.TsdfConfig()
+    config.voxel_size_m = 0.05
+    tsdf = dp.Tsdf(config)
+    for pose, depth in zip(poses, depths, strict=True):
+        tsdf.integrate_depth(depth, camera(cam), pose)
+    cells = tsdf.slice(dp.GridGeometry(100, 100, 0.05, -2.5, -2.5), 0.05, 1.8)
+    distance = dp.slice_distance(cells, 0.05, 0.6)
+    assert distance.shape == cells.shape and distance.dtype == np.float32
+    expected = np.minimum(0.6, 0.05 * distance_transform_edt(cells != 1))
+    known = cells >= 0
+    assert np.isnan(distance[~known]).all()
+    np.testing.assert_allclose(distance[known], expected[known], atol=1e-6)
+    assert (distance[cells == 1] == 0.0).all()
+    assert 0.0 < float(np.median(distance[cells == 0])) < 0.6  # free cells: some clearance
+    with pytest.raises(ValueError, match="2-D"):
+        dp.slice_distance(cells[0], 0.05)
+    with pytest.raises(ValueError, match="max_distance_m"):
+        dp.slice_distance(cells, 0.05, float("inf"))
+
+
 def test_octree_lesson_log_odds_and_room() -> None:
     # One ray: the end leaf +0.847 (p_hit 0.7), a leaf on the way -0.405 (p_miss 0.4).
     tree = dp.OccupancyOctree()

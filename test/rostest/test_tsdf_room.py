@@ -2,9 +2,10 @@
 """rostest: the TSDF nodelet on 20 simulated 16UC1 depth frames of the analytic room.
 
 The mesh it publishes (per-block TRIANGLE_LIST markers) must lie on the room's true surfaces;
-~save_mesh writes a PLY with as many vertices as it reports; frames with a wrong encoding, a
-size that disagrees with CameraInfo or a frame nobody publishes tf for are rejected and counted
-without stopping the node; ~clear empties the map and deletes the markers.
+~slice_distance is the exact clearance of ~slice; ~save_mesh writes a PLY with as many vertices
+as it reports; frames with a wrong encoding, a size that disagrees with CameraInfo or a frame
+nobody publishes tf for are rejected and counted without stopping the node; ~clear empties the
+map and deletes the markers.
 """
 
 from __future__ import annotations
@@ -57,7 +58,19 @@ class TsdfRoomTest(unittest.TestCase):
         def on_slice(msg: OccupancyGrid) -> None:
             cls.slice = msg
 
+        # Slices and clearance clouds by stamp: a pair published by one mesh tick shares it.
+        cls.slices: dict[rospy.Time, OccupancyGrid] = {}
+        cls.distances: dict[rospy.Time, PointCloud2] = {}
+
+        def on_slice_kept(msg: OccupancyGrid) -> None:
+            cls.slices[msg.header.stamp] = msg
+
+        def on_distance(msg: PointCloud2) -> None:
+            cls.distances[msg.header.stamp] = msg
+
         rospy.Subscriber("/tsdf/slice", OccupancyGrid, on_slice, queue_size=1)
+        rospy.Subscriber("/tsdf/slice", OccupancyGrid, on_slice_kept, queue_size=10)
+        rospy.Subscriber("/tsdf/slice_distance", PointCloud2, on_distance, queue_size=10)
         rospy.Subscriber("/tsdf/octomap_occupied", PointCloud2, on_octomap, queue_size=1)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
@@ -90,6 +103,33 @@ class TsdfRoomTest(unittest.TestCase):
         refused = save(os.path.join(tempfile.mkdtemp(), "room.obj"))
         self.assertFalse(refused.success)
         self.assertIn(".ply", refused.message)
+
+    def test_2a_slice_distance_is_the_clearance_of_the_slice(self) -> None:
+        # ~slice_distance: one point per known slice cell, its distance the exact Euclidean
+        # distance (m) to the nearest occupied cell of the slice of the same tick, capped at
+        # ~slice_distance_max_m (2 m).
+        from scipy.ndimage import distance_transform_edt
+
+        self.assertTrue(wait_until(lambda: self.done, 60.0), "the depth simulator never finished")
+        self.assertTrue(
+            wait_until(lambda: set(self.slices) & set(self.distances), 10.0),
+            f"{len(self.slices)} slices, {len(self.distances)} distance clouds",
+        )
+        stamp = max(set(self.slices) & set(self.distances))
+        grid, cloud = self.slices[stamp], self.distances[stamp]
+        self.assertEqual(self.status.get("slice distance cap (m)"), "2", self.status)
+        names = [f.name for f in cloud.fields]
+        self.assertEqual(names, ["x", "y", "z", "distance"])
+        points = np.array(list(point_cloud2.read_points(cloud, field_names=names)))
+        cells = np.array(grid.data, dtype=np.int8).reshape(grid.info.height, grid.info.width)
+        self.assertEqual(len(points), int((cells >= 0).sum()))
+        res = grid.info.resolution
+        col = np.floor((points[:, 0] - grid.info.origin.position.x) / res).astype(int)
+        row = np.floor((points[:, 1] - grid.info.origin.position.y) / res).astype(int)
+        expected = np.minimum(2.0, res * distance_transform_edt(cells != 100))[row, col]
+        np.testing.assert_allclose(points[:, 3], expected, atol=1e-4)
+        self.assertTrue((points[cells[row, col] == 100, 3] == 0.0).all())
+        self.assertGreater(int((points[:, 3] > 0.3).sum()), 100)  # open floor: clearance
 
     def test_2b_octomap_is_published_and_saved(self) -> None:
         self.assertIsNotNone(self.octomap, "no ~octomap_occupied cloud")

@@ -1,9 +1,14 @@
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+
+#include "downstream_perception/core/inflation.h"
 
 namespace downstream_perception {
 
@@ -78,6 +83,39 @@ std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
   }
   if (stats != nullptr) *stats = local;
   return cells;
+}
+
+std::vector<float> sliceDistance(const std::vector<SliceCell>& cells, const GridGeometry& grid,
+                                 double max_distance_m) {
+  const std::size_t n = static_cast<std::size_t>(grid.sizeX()) * grid.sizeY();
+  if (cells.size() != n) {
+    throw std::invalid_argument("slice distance: " + std::to_string(cells.size()) +
+                                " cells for a grid of " + std::to_string(n));
+  }
+  if (!(std::isfinite(max_distance_m) && max_distance_m >= 0.0)) {
+    throw std::invalid_argument("slice distance: max_distance_m must be finite and >= 0, got " +
+                                std::to_string(max_distance_m));
+  }
+  std::vector<float> distance(n, std::numeric_limits<float>::quiet_NaN());
+  if (n == 0) return distance;
+  std::vector<std::uint8_t> occupied(n);
+  std::transform(cells.begin(), cells.end(), occupied.begin(),
+                 [](SliceCell c) { return static_cast<std::uint8_t>(c == SliceCell::kOccupied); });
+  // The cap in whole cells, at most the grid's extent (beyond it nothing changes).
+  const double r = grid.resolution();
+  const int cap_cells = static_cast<int>(
+      std::min(std::ceil(max_distance_m / r), static_cast<double>(grid.sizeX() + grid.sizeY())));
+  const CellBounds all{0, 0, grid.sizeX() - 1, grid.sizeY() - 1};
+  std::vector<std::int32_t> squared;
+  boundedSquaredDistances(occupied.data(), grid.sizeX(), all, all, cap_cells, &squared);
+  const float cap = static_cast<float>(max_distance_m);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (cells[i] == SliceCell::kUnknown) continue;
+    distance[i] = squared[i] == kFarSquared
+                      ? cap
+                      : std::min(cap, static_cast<float>(std::sqrt(double(squared[i])) * r));
+  }
+  return distance;
 }
 
 }  // namespace downstream_perception

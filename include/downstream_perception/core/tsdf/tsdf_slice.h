@@ -38,4 +38,13 @@ GridGeometry sliceGeometry(const TsdfMap& map);
 std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
                                  const TsdfSliceConfig& config, TsdfSliceStats* stats = nullptr);
 
+/// Euclidean distance (m) from each cell's centre to the nearest occupied cell's centre (exact:
+/// a separable distance transform over squared cell distances), 0 on occupied cells, capped at
+/// max_distance_m, NaN on unknown cells (the distance does not see through them: it treats
+/// them as free). For planners that want clearance rather than a binary obstacle map. Throws
+/// std::invalid_argument when `cells` does not match `grid` or max_distance_m is not finite and
+/// >= 0.
+std::vector<float> sliceDistance(const std::vector<SliceCell>& cells, const GridGeometry& grid,
+                                 double max_distance_m);
+
 }  // namespace downstream_perception
