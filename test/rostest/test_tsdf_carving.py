@@ -71,6 +71,21 @@ class TsdfCarvingTest(unittest.TestCase):
         blocks = {n: int(self.status[n]["blocks"]) for n in ("tsdf_carving", "tsdf_plain")}
         self.assertGreater(blocks["tsdf_carving"], blocks["tsdf_plain"], blocks)
 
+    def test_slice_distance_cap_off_and_absurd(self) -> None:
+        # tsdf_carving: ~slice_distance_max_m 0 turns the clearance topic off (not advertised);
+        # tsdf_plain: -1 is refused at start-up, counted as a config error, 2 m used instead.
+        self.assertTrue(
+            wait_until(lambda: {"tsdf_carving", "tsdf_plain"} <= set(self.status), 20.0),
+            f"diagnostics: {self.status}",
+        )
+        self.assertEqual(self.status["tsdf_carving"]["slice distance cap (m)"], "off")
+        self.assertEqual(self.status["tsdf_plain"]["slice distance cap (m)"], "2")
+        self.assertGreaterEqual(int(self.status["tsdf_plain"]["config errors"]), 1)
+        self.assertEqual(int(self.status["tsdf_carving"]["config errors"]), 0)
+        topics = {name for name, _ in rospy.get_published_topics()}
+        self.assertIn("/tsdf_plain/slice_distance", topics)
+        self.assertNotIn("/tsdf_carving/slice_distance", topics)
+
 
 if __name__ == "__main__":
     rostest.rosrun("downstream_perception", "test_tsdf_carving", TsdfCarvingTest)
