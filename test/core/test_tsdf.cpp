@@ -475,6 +475,43 @@ TEST(Tsdf, MemoryIsBoundedByMaxBlocksAndDistance) {
       integrateDepth(&near, depth.data(), camera, Eigen::Isometry3d::Identity());
   EXPECT_GT(e.blocks_evicted, 0u);
   EXPECT_EQ(near.blockCount(), 0u);
+  // Evicted blocks' memory stays for reuse (the pool keeps its peak); clear() returns it.
+  EXPECT_GE(near.memoryBytes(), TsdfBlockPool::kChunkBytes);
+  capped.clear();
+  EXPECT_LT(capped.memoryBytes(), TsdfBlockPool::kChunkBytes);
+}
+
+TEST(TsdfBlockPool, ReusesReleasedBlocksZeroedAndFreesChunksWhenEmpty) {
+  TsdfBlockPool pool;
+  const std::size_t per_chunk = TsdfBlockPool::blocksPerChunk();
+  EXPECT_GE(per_chunk, 500u);  // 2 MiB of 4,104-byte blocks
+  std::vector<TsdfBlockPool::Ptr> blocks;
+  for (std::size_t i = 0; i < per_chunk + 3; ++i) {
+    blocks.push_back(pool.acquire());
+    blocks.back()->voxels[7].distance = static_cast<float>(i);
+    blocks.back()->voxels[kTsdfBlockVoxels - 1].weight = 1.0f;
+    blocks.back()->updated_stamp = i + 1;
+  }
+  EXPECT_EQ(pool.bytesReserved(), 2 * TsdfBlockPool::kChunkBytes);
+  EXPECT_EQ(pool.blocksInUse(), per_chunk + 3);
+  for (std::size_t i = 0; i < blocks.size(); ++i) {  // no block overlaps another
+    ASSERT_EQ(blocks[i]->voxels[7].distance, static_cast<float>(i));
+    ASSERT_EQ(blocks[i]->updated_stamp, i + 1);
+  }
+  for (std::size_t i = 0; i < blocks.size(); i += 2) blocks[i].reset();
+  pool.trim();  // blocks in use: nothing to give back
+  EXPECT_EQ(pool.bytesReserved(), 2 * TsdfBlockPool::kChunkBytes);
+  for (std::size_t i = 0; i < blocks.size(); i += 2) {
+    blocks[i] = pool.acquire();  // a reused slot, zeroed
+    EXPECT_EQ(blocks[i]->voxels[7].distance, 0.0f);
+    EXPECT_EQ(blocks[i]->voxels[kTsdfBlockVoxels - 1].weight, 0.0f);
+    EXPECT_EQ(blocks[i]->updated_stamp, 0u);
+  }
+  EXPECT_EQ(pool.bytesReserved(), 2 * TsdfBlockPool::kChunkBytes);
+  blocks.clear();
+  EXPECT_EQ(pool.blocksInUse(), 0u);
+  pool.trim();
+  EXPECT_EQ(pool.bytesReserved(), 0u);
 }
 
 TEST(MarchingCubes, EveryCaseUsesExactlyItsCrossingEdges) {

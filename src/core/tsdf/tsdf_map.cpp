@@ -82,7 +82,7 @@ TsdfBlock* TsdfMap::allocate(const Eigen::Vector3i& block) {
   auto it = blocks_.find(block);
   if (it != blocks_.end()) return it->second.get();
   if (blocks_.size() >= config_.max_blocks) return nullptr;
-  return blocks_.emplace(block, std::make_unique<TsdfBlock>()).first->second.get();
+  return blocks_.emplace(block, pool_->acquire()).first->second.get();
 }
 
 TsdfBlock* TsdfMap::find(const Eigen::Vector3i& block) {
@@ -120,11 +120,12 @@ std::size_t TsdfMap::evictFartherThan(const Eigen::Vector3d& center, double dist
 
 void TsdfMap::clear() {
   blocks_.clear();
+  pool_->trim();
   ++generation_;
 }
 
 std::size_t TsdfMap::memoryBytes() const {
-  return blocks_.size() * sizeof(TsdfBlock) +
+  return pool_->bytesReserved() +
          blocks_.bucket_count() * (sizeof(Eigen::Vector3i) + sizeof(void*) + sizeof(std::int32_t));
 }
 

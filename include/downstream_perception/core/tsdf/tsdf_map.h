@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "downstream_perception/core/tsdf/tsdf_block_pool.h"
+
 namespace downstream_perception {
 
 struct TsdfConfig {
@@ -90,10 +92,13 @@ struct BlockIndexHash {
 
 class TsdfMap {
  public:
-  using BlockMap = tsl::robin_map<Eigen::Vector3i, std::unique_ptr<TsdfBlock>, BlockIndexHash>;
+  using BlockMap = tsl::robin_map<Eigen::Vector3i, TsdfBlockPool::Ptr, BlockIndexHash>;
 
   /// Throws std::invalid_argument if the config is invalid.
   explicit TsdfMap(const TsdfConfig& config = {});
+  TsdfMap(TsdfMap&&) = default;
+  /// Not assignable: the default would free the old pool before the old blocks it holds.
+  TsdfMap& operator=(TsdfMap&&) = delete;
 
   const TsdfConfig& config() const { return config_; }
   /// Replaces the settings that do not define the voxel lattice (weights, depth limits,
@@ -134,7 +139,7 @@ class TsdfMap {
 
   const BlockMap& blocks() const { return blocks_; }
   std::size_t blockCount() const { return blocks_.size(); }
-  /// Bytes held by the blocks and the hash table.
+  /// Bytes held by the blocks (the pool's whole chunks) and the hash table.
   std::size_t memoryBytes() const;
 
   /// Incremented by each integration; blocks record the generation that last touched them, so a
@@ -145,6 +150,9 @@ class TsdfMap {
  private:
   TsdfConfig config_;
   float weight_cap_ = std::numeric_limits<float>::infinity();  ///< max_weight, or none (0)
+  /// Owns the blocks' memory; behind a pointer so moving the map keeps the blocks' deleters
+  /// valid, and declared before blocks_ so it outlives them.
+  std::unique_ptr<TsdfBlockPool> pool_ = std::make_unique<TsdfBlockPool>();
   BlockMap blocks_;
   std::uint64_t generation_ = 0;
 };
