@@ -136,6 +136,17 @@ def room_frames(image: str) -> tuple:
     return cam, scene, poses, depths, observed_samples(scene, cam, poses, depths)
 
 
+def room_tsdf_5cm() -> dp.Tsdf:
+    """The room fused from its 320x240 frames at 5 cm voxels."""
+    cam, _, poses, depths, _ = room_frames("qvga")
+    config = dp.TsdfConfig()
+    config.voxel_size_m = 0.05
+    tsdf = dp.Tsdf(config)
+    for pose, depth in zip(poses, depths, strict=True):
+        tsdf.integrate_depth(depth, camera(cam), pose)
+    return tsdf
+
+
 # (image, voxel) -> (mean error m, completeness, ghost fraction) bars. Measured on this room
 # (surfaces off the voxel lattice): 640x480 / 2 cm 0.29 mm, 0.9993, 0.046 %; 320x240 / 2 cm
 # 0.67 mm, 0.9991, 0.046 %; 320x240 / 5 cm 1.63 mm, 0.965, 0.49 %. Issue 5's goal at 640x480 /
@@ -245,12 +256,8 @@ def test_slice_puts_the_table_top_into_the_grid() -> None:
     # The room's objects in the 0.05-1.8 m band become obstacles in a 5 cm grid, including the
     # table top (0.72-0.76 m, floating: a 2-D lidar under it would see nothing) and the sphere
     # (0.9-1.5 m); the open floor is free; outside the room is unknown.
-    cam, scene, poses, depths, _ = room_frames("qvga")
-    config = dp.TsdfConfig()
-    config.voxel_size_m = 0.05
-    tsdf = dp.Tsdf(config)
-    for pose, depth in zip(poses, depths, strict=True):
-        tsdf.integrate_depth(depth, camera(cam), pose)
+    scene = room_scene()
+    tsdf = room_tsdf_5cm()
     grid = dp.GridGeometry(100, 100, 0.05, -2.5, -2.5)
     cells = tsdf.slice(grid, 0.05, 1.8)
     assert cells.shape == (100, 100)
@@ -274,13 +281,7 @@ def test_slice_distance_is_the_exact_euclidean_distance() -> None:
     # transform of "not occupied", capped, with NaN where the slice is unknown.
     from scipy.ndimage import distance_transform_edt
 
-    cam, _, poses, depths, _ = room_frames("qvga")
-    config = dp.TsdfConfig()
-    config.voxel_size_m = 0.05
-    tsdf = dp.Tsdf(config)
-    for pose, depth in zip(poses, depths, strict=True):
-        tsdf.integrate_depth(depth, camera(cam), pose)
-    cells = tsdf.slice(dp.GridGeometry(100, 100, 0.05, -2.5, -2.5), 0.05, 1.8)
+    cells = room_tsdf_5cm().slice(dp.GridGeometry(100, 100, 0.05, -2.5, -2.5), 0.05, 1.8)
     distance = dp.slice_distance(cells, 0.05, 0.6)
     assert distance.shape == cells.shape and distance.dtype == np.float32
     expected = np.minimum(0.6, 0.05 * distance_transform_edt(cells != 1))
