@@ -379,9 +379,9 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   // follow.
   std::vector<TsdfBlock*> blocks(keys.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    const bool existed = map->find(keys[i]) != nullptr;
-    blocks[i] = map->allocate(keys[i]);
-    stats.blocks_allocated += !existed && blocks[i] != nullptr;
+    bool created = false;
+    blocks[i] = map->allocate(keys[i], &created);
+    stats.blocks_allocated += created;
     stats.blocks_refused += blocks[i] == nullptr;
   }
   for (std::size_t i = 0; i < keys.size(); ++i) {
@@ -560,13 +560,13 @@ TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vect
     for (double t_cell = t0; t_cell <= t1;) {
       const Eigen::Vector3i key = TsdfMap::blockOf(cell);
       if (key != cached_key) {
-        const bool existed = map->find(key) != nullptr;
-        cached = map->allocate(key);
+        bool created = false;
+        cached = map->allocate(key, &created);
         cached_key = key;
         if (cached == nullptr) {
           ++stats.blocks_refused;
         } else {
-          stats.blocks_allocated += !existed;
+          stats.blocks_allocated += created;
           touched_keys.insert(key);
           cached->updated_stamp = generation;
         }

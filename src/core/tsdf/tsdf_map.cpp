@@ -78,10 +78,12 @@ Eigen::Vector3i TsdfMap::voxelAt(const Eigen::Vector3d& p) const {
           static_cast<int>(std::lround(s.z()))};
 }
 
-TsdfBlock* TsdfMap::allocate(const Eigen::Vector3i& block) {
+TsdfBlock* TsdfMap::allocate(const Eigen::Vector3i& block, bool* created) {
+  if (created != nullptr) *created = false;
   auto it = blocks_.find(block);
   if (it != blocks_.end()) return it->second.get();
   if (blocks_.size() >= config_.max_blocks) return nullptr;
+  if (created != nullptr) *created = true;
   return blocks_.emplace(block, pool_->acquire()).first->second.get();
 }
 

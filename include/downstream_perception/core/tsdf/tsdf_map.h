@@ -117,8 +117,9 @@ class TsdfMap {
     return voxel.cast<double>() * config_.voxel_size_m;
   }
 
-  /// The block, created if missing (nullptr when max_blocks is reached).
-  TsdfBlock* allocate(const Eigen::Vector3i& block);
+  /// The block, created if missing (nullptr when max_blocks is reached); `created`, if given,
+  /// says whether this call created it (one hash lookup instead of a find() first).
+  TsdfBlock* allocate(const Eigen::Vector3i& block, bool* created = nullptr);
   TsdfBlock* find(const Eigen::Vector3i& block);
   const TsdfBlock* find(const Eigen::Vector3i& block) const;
   /// The voxel if its block exists, else nullptr.
