@@ -5,10 +5,10 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build test demo bench lint clean
+.PHONY: help deps build test demo bench bench-open3d lint clean
 
 help:
-	@echo "make demo | make test | make bench | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make bench | make bench-open3d | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -25,6 +25,12 @@ demo: build
 
 bench: build
 	@source tools/env.sh && source_workspace && python3 scripts/bench.py --out out
+
+# TSDF integration side by side with Open3D 0.19 (installed into .ws/open3d-venv for this only).
+bench-open3d: build
+	@tools/open3d_venv.sh
+	@source tools/env.sh && source_workspace && OMP_NUM_THREADS=1 \
+		"$$WS/open3d-venv/bin/python" scripts/bench_open3d.py
 
 lint:
 	@tools/lint.sh

@@ -146,7 +146,7 @@ def markdown(rows: list[dict[str, Any]]) -> list[str]:
             f"{r['full_mesh_ms']:.1f} | {r['incremental_mesh_ms']:.1f} ({r['blocks_remeshed']}) | "
             f"{r['slice_ms']:.1f} + {r['slice_clearance_ms']:.1f} | "
             f"{r['blocks']} | {r['memory_mb']:.1f} | {r['mean_mm']:.2f} / {r['p95_mm']:.2f} | "
-            f"{r['ghost_pct']:.2f} | {r['completeness']:.4f} |"
+            f"{r['ghost_pct']:.3f} | {r['completeness']:.4f} |"
         )
     for r in rows:
         if "octomap_insert_median_ms" in r:
