@@ -127,9 +127,10 @@ def markdown(rows: list[dict[str, Any]]) -> list[str]:
         "",
         "Through the Python binding (it reads float32 depth in place). Open3D 0.19 "
         "single-thread figures from the anchor notes (same scene kind and machine kind): legacy "
-        "/ tensor integrate ms. Accuracy: |true SDF| at mesh vertices; ghosts: vertices more "
-        "than one voxel off every surface; completeness: observed surface within 2 cm of the "
-        "mesh. Goal: <= 5 / 10 ms per frame (320x240 / 640x480, 2 cm), <= 50 ms full re-mesh.",
+        "/ tensor integrate ms (side by side on the same frames: make bench-open3d). "
+        "Accuracy: |true SDF| at mesh vertices; ghosts: vertices more than one voxel off every "
+        "surface; completeness: observed surface within 2 cm of the mesh. Goal: <= 5 / 10 ms "
+        "per frame (320x240 / 640x480, 2 cm), <= 50 ms full re-mesh.",
         "",
         "| image | voxel | integrate ms (p90) | Open3D legacy / tensor ms | full mesh ms | "
         "one-frame re-mesh ms (blocks) | slice + clearance ms | blocks | MB | mean / p95 mm | "
