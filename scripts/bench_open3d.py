@@ -91,6 +91,7 @@ def open3d_tensor(depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam
         "depth_max": 10.0,
         "trunc_voxel_multiplier": float(TRUNCATION_VOXELS),
     }
+    # Open3D reads 0 as invalid; +Inf (no return) becomes the largest float, beyond depth_max.
     images = [o3d.t.geometry.Image(o3c.Tensor(np.nan_to_num(d, nan=0.0))) for d in depths]
 
     def integrate(image: Any, extrinsic: Any) -> None:
@@ -195,6 +196,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=6, help="alternating rounds per image")
     args = parser.parse_args()
+    if args.rounds < 1:
+        parser.error("--rounds must be at least 1")
     if os.environ.get("OMP_NUM_THREADS") != "1":
         raise SystemExit("set OMP_NUM_THREADS=1: the comparison is on one thread")
     from downstream_perception.sim.depth_camera import DepthCamera, circle_poses, room_scene

@@ -15,3 +15,11 @@ source_workspace() {
   ((had_u)) && set -u
   return 0
 }
+system_venv() {
+  # A venv at $1 on top of Debian's python3 and its packages (--system-site-packages: rospy,
+  # numpy and the built workspace's packages stay Debian's). Idempotent.
+  if [[ ! -x "$1/bin/python" ]]; then
+    mkdir -p "$(dirname "$1")"
+    /usr/bin/python3 -m venv --system-site-packages "$1"
+  fi
+}

@@ -5,10 +5,7 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 venv="$WS/py-venv"
-if [[ ! -x "$venv/bin/python" ]]; then
-  mkdir -p "$WS"
-  /usr/bin/python3 -m venv --system-site-packages "$venv"
-fi
+system_venv "$venv"
 if ! "$venv/bin/python" -c "import motmetrics" 2> /dev/null; then
   # Its dependencies (pandas, scipy, xmltodict) are Debian packages (tools/apt-packages.txt).
   if ! "$venv/bin/pip" install -q --no-deps "motmetrics==1.4.0"; then
