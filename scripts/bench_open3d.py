@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from bench_tsdf import timed_frames  # scripts/bench_tsdf.py, next to this file
 
 VOXEL_M = 0.02
 TRUNCATION_VOXELS = 4
@@ -43,18 +44,6 @@ def timed(work: Callable[[], object]) -> float:
     return 1e3 * (time.perf_counter() - t0)
 
 
-def timed_each(
-    work: Callable[[Any, Any], object], frames: Sequence[Any], poses: Sequence[Any]
-) -> list[float]:
-    """ms taken by work(frame, pose) for each frame (inputs prepared before, outside the clock)."""
-    elapsed = []
-    for frame, pose in zip(frames, poses, strict=True):
-        t0 = time.perf_counter()
-        work(frame, pose)
-        elapsed.append(1e3 * (time.perf_counter() - t0))
-    return elapsed
-
-
 def ours(depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any) -> Timing:
     import downstream_perception as dp
 
@@ -63,9 +52,7 @@ def ours(depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any) ->
     config.truncation_voxels = TRUNCATION_VOXELS
     tsdf = dp.Tsdf(config)
     pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
-    elapsed = timed_each(
-        lambda depth, pose: tsdf.integrate_depth(depth, pinhole, pose), depths, poses
-    )
+    elapsed = timed_frames(tsdf.integrate_depth, depths, pinhole, poses)
     return Timing(elapsed, timed(tsdf.update_mesh))  # the first extraction meshes every block
 
 
@@ -94,12 +81,12 @@ def open3d_tensor(depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam
     # Open3D reads 0 as invalid; +Inf (no return) becomes the largest float, beyond depth_max.
     images = [o3d.t.geometry.Image(o3c.Tensor(np.nan_to_num(d, nan=0.0))) for d in depths]
 
-    def integrate(image: Any, extrinsic: Any) -> None:
+    def integrate(image: Any, intrinsic: Any, extrinsic: Any) -> None:
         blocks = grid.compute_unique_block_coordinates(image, intrinsic, extrinsic, **options)
         grid.integrate(blocks, image, intrinsic, extrinsic, **options)
 
     extrinsics = [o3c.Tensor(np.linalg.inv(pose)) for pose in poses]
-    elapsed = timed_each(integrate, images, extrinsics)
+    elapsed = timed_frames(integrate, images, intrinsic, extrinsics)
     return Timing(elapsed, timed(lambda: grid.extract_triangle_mesh(weight_threshold=1.0)))
 
 
@@ -127,7 +114,7 @@ def open3d_legacy(depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam
         color_type=o3d.pipelines.integration.TSDFVolumeColorType.NoColor,
     )
     extrinsics = [np.linalg.inv(pose) for pose in poses]
-    elapsed = timed_each(lambda f, E: volume.integrate(f, intrinsic, E), frames, extrinsics)
+    elapsed = timed_frames(volume.integrate, frames, intrinsic, extrinsics)
     return Timing(elapsed, timed(volume.extract_triangle_mesh))
 
 

@@ -16,6 +16,7 @@ SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "bench_open3d.py"
 
 @pytest.fixture(scope="module")
 def bench() -> Any:
+    sys.path.insert(0, str(SCRIPT.parent))  # it imports bench_tsdf from next to it
     spec = importlib.util.spec_from_file_location("bench_open3d", SCRIPT)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
