@@ -1,5 +1,7 @@
 #include "downstream_perception/costmap_publisher.h"
 
+#include "downstream_perception/map_meta_data.h"
+
 namespace downstream_perception {
 
 CostmapPublisher::CostmapPublisher(ros::NodeHandle& nh, const std::string& topic,
@@ -19,14 +21,7 @@ void CostmapPublisher::toMessage(const Costmap& costmap, const std::string& fram
   const GridGeometry& g = costmap.geometry();
   msg->header.frame_id = frame_id;
   msg->header.stamp = stamp;
-  msg->info.map_load_time = stamp;
-  msg->info.resolution = static_cast<float>(g.resolution());
-  msg->info.width = static_cast<std::uint32_t>(g.sizeX());
-  msg->info.height = static_cast<std::uint32_t>(g.sizeY());
-  msg->info.origin.position.x = g.originX();
-  msg->info.origin.position.y = g.originY();
-  msg->info.origin.position.z = 0.0;
-  msg->info.origin.orientation.w = 1.0;
+  msg->info = mapMetaData(g, 0.0, stamp);
   msg->data.resize(g.cellCount());
   const std::uint8_t* src = costmap.data();
   for (std::size_t i = 0; i < g.cellCount(); ++i) msg->data[i] = kTable[src[i]];

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "downstream_perception/map_meta_data.h"
+
 namespace downstream_perception {
 
 nav_msgs::OccupancyGridPtr sliceGridMessage(const std::vector<SliceCell>& cells,
@@ -12,14 +14,7 @@ nav_msgs::OccupancyGridPtr sliceGridMessage(const std::vector<SliceCell>& cells,
                                             const std_msgs::Header& header) {
   nav_msgs::OccupancyGridPtr msg(new nav_msgs::OccupancyGrid);
   msg->header = header;
-  msg->info.map_load_time = header.stamp;
-  msg->info.resolution = static_cast<float>(grid.resolution());
-  msg->info.width = static_cast<std::uint32_t>(grid.sizeX());
-  msg->info.height = static_cast<std::uint32_t>(grid.sizeY());
-  msg->info.origin.position.x = grid.originX();
-  msg->info.origin.position.y = grid.originY();
-  msg->info.origin.position.z = z_m;
-  msg->info.origin.orientation.w = 1.0;
+  msg->info = mapMetaData(grid, z_m, header.stamp);
   msg->data.resize(cells.size());
   for (std::size_t i = 0; i < cells.size(); ++i) {
     msg->data[i] = cells[i] == SliceCell::kOccupied ? 100 : (cells[i] == SliceCell::kFree ? 0 : -1);
