@@ -4,11 +4,15 @@
 #pragma once
 
 #include <geometry_msgs/PoseStamped.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <string>
+#include <vector>
 
 namespace downstream_perception {
 
@@ -20,6 +24,31 @@ std::string checkScan(const sensor_msgs::LaserScan& msg);
 /// x, y, z consecutive little-endian FLOAT32 fields, and point_step, row_step and the data size
 /// agreeing with width and height. *x_offset (if given) receives the x field's offset.
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg, std::size_t* x_offset = nullptr);
+
+/// False with a reason for a depth image the TSDF cannot read: an encoding other than 32FC1 /
+/// 16UC1, a byte order other than the host's, or an inconsistent size.
+bool checkDepthImage(const sensor_msgs::Image& image, std::string* why);
+
+/// A depth image as metres (32FC1 as is, 16UC1 millimetres converted, 0 -> NaN), after
+/// checkDepthImage() (false with its reason).
+bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
+                        std::string* why);
+
+/// Calls visit(x, y, z) (floats, NaN passed on) for each point of a cloud that passed
+/// checkCloudLayout, which gave x_offset. Reads through the checked row_step and point_step only,
+/// so no field offset of the message can take it outside the data.
+template <class Visitor>
+void forEachCloudPoint(const sensor_msgs::PointCloud2& msg, std::size_t x_offset,
+                       Visitor&& visit) {
+  for (std::size_t row = 0; row < msg.height; ++row) {
+    const std::uint8_t* p = msg.data.data() + row * msg.row_step + x_offset;
+    for (std::size_t k = 0; k < msg.width; ++k, p += msg.point_step) {
+      float xyz[3];
+      std::memcpy(xyz, p, sizeof(xyz));  // PointCloud2 data need not be aligned
+      visit(xyz[0], xyz[1], xyz[2]);
+    }
+  }
+}
 
 /// A frame, a finite position and a finite unit quaternion (|q| within 1 %: rounding in a
 /// hand-written goal is forgiven, a zero quaternion is not).

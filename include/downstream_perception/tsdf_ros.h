@@ -42,15 +42,6 @@
 
 namespace downstream_perception {
 
-/// False with a reason for a depth image this node cannot read: an encoding other than 32FC1 /
-/// 16UC1, a byte order other than the host's, or an inconsistent size.
-bool checkDepthImage(const sensor_msgs::Image& image, std::string* why);
-
-/// A depth image as metres (32FC1 as is, 16UC1 millimetres converted, 0 -> NaN), after
-/// checkDepthImage() (false with its reason).
-bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
-                        std::string* why);
-
 class TsdfRos {
  public:
   TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh);

@@ -1,12 +1,27 @@
 #include "downstream_perception/message_checks.h"
 
+#include <sensor_msgs/image_encodings.h>
+
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <sstream>
 
 #include "downstream_perception/core/scan_integrator.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"
 
 namespace downstream_perception {
+
+namespace {
+
+bool hostIsBigEndian() {
+  const std::uint16_t one = 1;
+  std::uint8_t first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
+}
+
+}  // namespace
 
 std::string checkScan(const sensor_msgs::LaserScan& msg) {
   const LaserScanView view{msg.ranges.data(),   msg.ranges.size(), msg.angle_min,
@@ -39,23 +54,29 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg, std::size_t* x
   const sensor_msgs::PointField* x = field("x");
   const sensor_msgs::PointField* y = field("y");
   const sensor_msgs::PointField* z = field("z");
+  // Every size and offset below is a uint32 of the message: sums and products are taken in 64
+  // bits so that no crafted value can wrap around and pass (an x offset of 2^32 - 8 plus 12).
+  using U64 = std::uint64_t;
   std::ostringstream why;
   if (x == nullptr || y == nullptr || z == nullptr) {
     why << "no x, y and z fields";
   } else if (x->datatype != sensor_msgs::PointField::FLOAT32 ||
              y->datatype != sensor_msgs::PointField::FLOAT32 ||
-             z->datatype != sensor_msgs::PointField::FLOAT32 || y->offset != x->offset + 4 ||
-             z->offset != x->offset + 8) {
+             z->datatype != sensor_msgs::PointField::FLOAT32 || x->count == 0 || y->count == 0 ||
+             z->count == 0 || U64{y->offset} != U64{x->offset} + 4 ||
+             U64{z->offset} != U64{x->offset} + 8) {
     why << "x, y, z must be consecutive FLOAT32 fields";
   } else if (msg.is_bigendian) {
     why << "big-endian clouds are not supported";
-  } else if (msg.point_step < x->offset + 12) {
-    why << "point_step " << msg.point_step << " is smaller than the x, y, z fields";
-  } else if (static_cast<std::uint64_t>(msg.width) * msg.point_step > msg.row_step) {
-    why << "row_step " << msg.row_step << " < width * point_step";
-  } else if (static_cast<std::uint64_t>(msg.row_step) * msg.height != msg.data.size()) {
-    why << "data holds " << msg.data.size()
-        << " bytes, row_step * height = " << static_cast<std::uint64_t>(msg.row_step) * msg.height;
+  } else if (U64{msg.point_step} < U64{x->offset} + 12) {
+    why << "point_step " << msg.point_step << " is smaller than the x, y, z fields (x at offset "
+        << x->offset << ")";
+  } else if (U64{msg.width} * msg.point_step > msg.row_step) {
+    why << "row_step " << msg.row_step << " < width * point_step = "
+        << U64{msg.width} * msg.point_step;
+  } else if (U64{msg.row_step} * msg.height != msg.data.size()) {
+    why << "data holds " << msg.data.size() << " bytes, row_step * height = "
+        << U64{msg.row_step} * msg.height;
   } else if (x_offset != nullptr) {
     *x_offset = x->offset;
   }
@@ -76,6 +97,48 @@ std::string checkPose(const geometry_msgs::PoseStamped& msg) {
     return s.str();
   }
   return {};
+}
+
+bool checkDepthImage(const sensor_msgs::Image& image, std::string* why) {
+  namespace enc = sensor_msgs::image_encodings;
+  const bool is_float = image.encoding == enc::TYPE_32FC1;
+  const bool is_mm = image.encoding == enc::TYPE_16UC1 || image.encoding == enc::MONO16;
+  if (!is_float && !is_mm) {
+    *why = "encoding '" + image.encoding + "' (need 32FC1 metres or 16UC1 millimetres)";
+    return false;
+  }
+  if (static_cast<bool>(image.is_bigendian) != hostIsBigEndian()) {
+    *why = "byte order differs from this machine's";
+    return false;
+  }
+  const std::size_t pixel_bytes = is_float ? 4 : 2;
+  if (image.width == 0 || image.height == 0 || image.step < image.width * pixel_bytes ||
+      image.data.size() < static_cast<std::size_t>(image.step) * image.height) {
+    *why = "size inconsistent (width " + std::to_string(image.width) + ", height " +
+           std::to_string(image.height) + ", step " + std::to_string(image.step) + ", " +
+           std::to_string(image.data.size()) + " bytes)";
+    return false;
+  }
+  return true;
+}
+
+bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
+                        std::string* why) {
+  if (!checkDepthImage(image, why)) return false;
+  const bool is_float = image.encoding == sensor_msgs::image_encodings::TYPE_32FC1;
+  metres->resize(static_cast<std::size_t>(image.width) * image.height);
+  std::vector<std::uint16_t> mm(is_float ? 0 : image.width);  // one row, aligned
+  for (std::uint32_t v = 0; v < image.height; ++v) {
+    const std::uint8_t* row = image.data.data() + static_cast<std::size_t>(v) * image.step;
+    float* out = metres->data() + static_cast<std::size_t>(v) * image.width;
+    if (is_float) {
+      std::memcpy(out, row, image.width * sizeof(float));
+    } else {
+      std::memcpy(mm.data(), row, image.width * sizeof(std::uint16_t));
+      millimetresToMetres(mm.data(), mm.size(), out);
+    }
+  }
+  return true;
 }
 
 }  // namespace downstream_perception

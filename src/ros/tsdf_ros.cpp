@@ -1,11 +1,9 @@
 #include "downstream_perception/tsdf_ros.h"
 
-#include <sensor_msgs/image_encodings.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <functional>
 #include <sstream>
 #include <utility>
@@ -13,6 +11,7 @@
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "downstream_perception/message_checks.h"
 #include "downstream_perception/tf_failure.h"
 #include "downstream_perception/tsdf_params.h"
 #include "downstream_perception/tsdf_slice_messages.h"
@@ -20,13 +19,6 @@
 namespace downstream_perception {
 
 namespace {
-
-bool hostIsBigEndian() {
-  const std::uint16_t one = 1;
-  std::uint8_t first = 0;
-  std::memcpy(&first, &one, 1);
-  return first == 0;
-}
 
 Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -59,48 +51,6 @@ void replyToSave(const char* service, const std::string& path, const std::string
 }
 
 }  // namespace
-
-bool checkDepthImage(const sensor_msgs::Image& image, std::string* why) {
-  namespace enc = sensor_msgs::image_encodings;
-  const bool is_float = image.encoding == enc::TYPE_32FC1;
-  const bool is_mm = image.encoding == enc::TYPE_16UC1 || image.encoding == enc::MONO16;
-  if (!is_float && !is_mm) {
-    *why = "encoding '" + image.encoding + "' (need 32FC1 metres or 16UC1 millimetres)";
-    return false;
-  }
-  if (static_cast<bool>(image.is_bigendian) != hostIsBigEndian()) {
-    *why = "byte order differs from this machine's";
-    return false;
-  }
-  const std::size_t pixel_bytes = is_float ? 4 : 2;
-  if (image.width == 0 || image.height == 0 || image.step < image.width * pixel_bytes ||
-      image.data.size() < static_cast<std::size_t>(image.step) * image.height) {
-    *why = "size inconsistent (width " + std::to_string(image.width) + ", height " +
-           std::to_string(image.height) + ", step " + std::to_string(image.step) + ", " +
-           std::to_string(image.data.size()) + " bytes)";
-    return false;
-  }
-  return true;
-}
-
-bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
-                        std::string* why) {
-  if (!checkDepthImage(image, why)) return false;
-  const bool is_float = image.encoding == sensor_msgs::image_encodings::TYPE_32FC1;
-  metres->resize(static_cast<std::size_t>(image.width) * image.height);
-  std::vector<std::uint16_t> mm(is_float ? 0 : image.width);  // one row, aligned
-  for (std::uint32_t v = 0; v < image.height; ++v) {
-    const std::uint8_t* row = image.data.data() + static_cast<std::size_t>(v) * image.step;
-    float* out = metres->data() + static_cast<std::size_t>(v) * image.width;
-    if (is_float) {
-      std::memcpy(out, row, image.width * sizeof(float));
-    } else {
-      std::memcpy(mm.data(), row, image.width * sizeof(std::uint16_t));
-      millimetresToMetres(mm.data(), mm.size(), out);
-    }
-  }
-  return true;
-}
 
 template <class M>
 std::unique_ptr<tf2_ros::MessageFilter<M>> TsdfRos::tfFilter(
@@ -372,19 +322,9 @@ void TsdfRos::onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg) {
     reject("bad message: zero stamp", "point clouds must carry their measurement time");
     return;
   }
-  bool has_xyz[3] = {false, false, false};
-  for (const auto& f : msg->fields) {
-    for (int k = 0; k < 3; ++k) {
-      if (f.name == std::string(1, static_cast<char>('x' + k)) &&
-          f.datatype == sensor_msgs::PointField::FLOAT32) {
-        has_xyz[k] = true;
-      }
-    }
-  }
-  if (!has_xyz[0] || !has_xyz[1] || !has_xyz[2] ||
-      msg->data.size() < static_cast<std::size_t>(msg->row_step) * msg->height ||
-      msg->row_step < msg->width * msg->point_step) {
-    reject("bad point cloud", "need float32 x, y, z fields and a consistent size");
+  const std::string why = checkCloudLayout(*msg);  // the layout every cloud consumer checks
+  if (!why.empty()) {
+    reject("bad point cloud", why);
     return;
   }
   cloud_filter_->add(msg);
@@ -397,12 +337,13 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     reject("tf: lookup at stamp failed", why);
     return;
   }
+  std::size_t x_offset = 0;
+  if (!checkCloudLayout(*msg, &x_offset).empty()) return;  // checked on arrival (onCloudRaw)
   std::vector<Eigen::Vector3d> points;
   points.reserve(static_cast<std::size_t>(msg->width) * msg->height);
-  for (sensor_msgs::PointCloud2ConstIterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z");
-       x != x.end(); ++x, ++y, ++z) {
-    points.push_back(T_world_sensor * Eigen::Vector3d(*x, *y, *z));  // NaN stays NaN: counted
-  }
+  forEachCloudPoint(*msg, x_offset, [&](float x, float y, float z) {
+    points.push_back(T_world_sensor * Eigen::Vector3d(x, y, z));  // NaN stays NaN: counted
+  });
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto t0 = std::chrono::steady_clock::now();
