@@ -38,6 +38,7 @@
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/running_stats.h"
+#include "downstream_perception/save_service.h"
 #include "downstream_perception/tsdf_mesh_markers.h"
 
 namespace downstream_perception {
@@ -102,6 +103,7 @@ class TsdfRos {
   double slice_distance_max_m_ = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
   TsdfSliceStats slice_stats_;
   ros::ServiceServer save_service_;
+  OutputDirectory output_directory_{defaultOutputDirectory()};  ///< ~output_dir: services write here
   ros::ServiceServer clear_service_;
   ros::Timer mesh_timer_;
   diagnostic_updater::Updater diagnostics_;

@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <sstream>
 #include <utility>
 
@@ -12,6 +11,7 @@
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/message_checks.h"
+#include "downstream_perception/save_service.h"
 #include "downstream_perception/tf_failure.h"
 #include "downstream_perception/tsdf_params.h"
 #include "downstream_perception/tsdf_slice_messages.h"
@@ -27,27 +27,6 @@ Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
                    .toRotationMatrix();
   T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
   return T;
-}
-
-/// Fills a SaveMap reply: the extension check, the writer's outcome (error or "" and what was
-/// written) and one log line.
-void replyToSave(const char* service, const std::string& path, const std::string& extension,
-                 SaveMap::Response& response,
-                 const std::function<std::pair<std::string, std::string>()>& write) {
-  if (path.size() <= extension.size() ||
-      path.compare(path.size() - extension.size(), extension.size(), extension) != 0) {
-    response.success = false;
-    response.message = "only " + extension + " is supported, got '" + path + "'";
-  } else {
-    const auto [why, written] = write();
-    response.success = why.empty();
-    response.message = why.empty() ? "wrote " + written + " to " + path : why;
-  }
-  if (response.success) {
-    ROS_INFO("tsdf: %s", response.message.c_str());
-  } else {
-    ROS_ERROR("tsdf: %s failed: %s", service, response.message.c_str());
-  }
 }
 
 }  // namespace
@@ -72,6 +51,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
   config_errors_.setPrefix("tsdf");
   pnh_.param("world_frame", world_frame_, std::string("odom"));
+  output_directory_ = readOutputDirectory(pnh_, &config_errors_);
   double mesh_rate_hz = 1.0;
   pnh_.param("mesh_rate_hz", mesh_rate_hz, mesh_rate_hz);
   if (!(std::isfinite(mesh_rate_hz) && mesh_rate_hz > 0.0 && mesh_rate_hz <= 100.0)) {
@@ -155,10 +135,13 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   reconfigure_server_->setCallback(
       boost::bind(&TsdfRos::reconfigure, this, boost::placeholders::_1, boost::placeholders::_2));
   const TsdfConfig& c = map_->config();
-  ROS_INFO("tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s",
-           c.voxel_size_m, c.truncation(), world_frame_.c_str(),
-           ros::names::resolve(nh_.getNamespace(), "depth/image").c_str(),
-           ros::names::resolve(nh_.getNamespace(), "points").c_str());
+  ROS_INFO(
+      "tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s; files saved "
+      "into %s",
+      c.voxel_size_m, c.truncation(), world_frame_.c_str(),
+      ros::names::resolve(nh_.getNamespace(), "depth/image").c_str(),
+      ros::names::resolve(nh_.getNamespace(), "points").c_str(),
+      output_directory_.directory().c_str());
 }
 
 TsdfRos::~TsdfRos() {
@@ -428,30 +411,31 @@ sensor_msgs::PointCloud2Ptr TsdfRos::occupiedCloud(const std_msgs::Header& heade
 }
 
 bool TsdfRos::saveOctomap(SaveMap::Request& request, SaveMap::Response& response) {
-  replyToSave("save_octomap", request.path, ".bt", response, [&] {
-    return octree_->read([&](const OccupancyOctree& tree) {
-      return std::make_pair(tree.writeBinary(request.path),
-                            std::to_string(tree.leafCount()) + " leaves");
-    });
-  });
-  return true;
+  return serveSave("tsdf", "save_octomap", output_directory_, ".bt", request, response,
+                   [&](std::ostream& out, std::string* what) {
+                     return octree_->read([&](const OccupancyOctree& tree) {
+                       *what = std::to_string(tree.leafCount()) + " leaves";
+                       return tree.writeBinary(out);
+                     });
+                   });
 }
 
 bool TsdfRos::saveMesh(SaveMap::Request& request, SaveMap::Response& response) {
-  // A mesher of its own: the published one's lastUpdated() feeds the markers and must not be
-  // consumed here.
-  TsdfMesher mesher;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    mesher.update(*map_);
-  }
-  const TriangleMesh mesh = mesher.combined();
-  replyToSave("save_mesh", request.path, ".ply", response, [&] {
-    return std::make_pair(mesh.writePly(request.path),
-                          std::to_string(mesh.vertices.size()) + " vertices, " +
-                              std::to_string(mesh.triangleCount()) + " triangles");
-  });
-  return true;
+  return serveSave("tsdf", "save_mesh", output_directory_, ".ply", request, response,
+                   [&](std::ostream& out, std::string* what) {
+                     // A mesher of its own: the published one's lastUpdated() feeds the
+                     // markers and must not be consumed here.
+                     TsdfMesher mesher;
+                     {
+                       std::lock_guard<std::mutex> lock(mutex_);
+                       mesher.update(*map_);
+                     }
+                     const TriangleMesh mesh = mesher.combined();
+                     mesh.writePly(out);
+                     *what = std::to_string(mesh.vertices.size()) + " vertices, " +
+                             std::to_string(mesh.triangleCount()) + " triangles";
+                     return static_cast<bool>(out);
+                   });
 }
 
 bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {

@@ -92,17 +92,66 @@ class TsdfRoomTest(unittest.TestCase):
     def test_2_save_mesh_writes_a_ply(self) -> None:
         rospy.wait_for_service("/tsdf/save_mesh", 5.0)
         save = rospy.ServiceProxy("/tsdf/save_mesh", SaveMap)
-        path = os.path.join(tempfile.mkdtemp(), "room.ply")
-        reply = save(path)
+        out_dir = rospy.get_param("/tsdf/output_dir")
+        run = f"run-{os.getpid()}-{time.time_ns()}"  # a fresh subdirectory of ~output_dir
+        reply = save(f"{run}/room.ply", False)
         self.assertTrue(reply.success, reply.message)
+        path = os.path.join(out_dir, run, "room.ply")
+        self.assertEqual(reply.written_path, path)
         with open(path, "rb") as f:
             header = f.read(400).split(b"end_header")[0].decode()
         vertices = int(header.split("element vertex ")[1].split()[0])
         self.assertGreater(vertices, 10000)
         self.assertIn(f"wrote {vertices} vertices", reply.message)
-        refused = save(os.path.join(tempfile.mkdtemp(), "room.obj"))
+        self.assertIn(path, reply.message)
+        refused = save(f"{run}/room.obj", False)
         self.assertFalse(refused.success)
         self.assertIn(".ply", refused.message)
+
+        # An existing file is kept unless the caller asks to overwrite it.
+        size = os.path.getsize(path)
+        with open(path, "ab") as f:
+            f.write(b"marker")
+        kept = save(f"{run}/room.ply", False)
+        self.assertFalse(kept.success)
+        self.assertIn("exists", kept.message)
+        self.assertEqual(os.path.getsize(path), size + 6)
+        self.assertTrue(save(f"{run}/room.ply", True).success)
+        self.assertEqual(os.path.getsize(path), size)
+
+    def test_2d_save_services_write_only_inside_the_output_directory(self) -> None:
+        rospy.wait_for_service("/tsdf/save_mesh", 5.0)
+        save = rospy.ServiceProxy("/tsdf/save_mesh", SaveMap)
+        save_octomap = rospy.ServiceProxy("/tsdf/save_octomap", SaveMap)
+        out_dir = rospy.get_param("/tsdf/output_dir")
+        run = f"run-{os.getpid()}-{time.time_ns()}"
+        outside = tempfile.mkdtemp()
+        victim = os.path.join(outside, "victim.txt")
+        with open(victim, "w") as f:
+            f.write("precious")
+        os.makedirs(os.path.join(out_dir, run))
+        os.symlink(victim, os.path.join(out_dir, run, "link.ply"))
+        os.symlink(victim, os.path.join(out_dir, run, "link.bt"))
+        os.symlink(outside, os.path.join(out_dir, run, "up"))
+        crafted = {
+            "NUL hiding the extension": victim + "\0.ply",
+            "absolute path": os.path.join(outside, "victim.ply"),
+            "escape with ..": f"{run}/../../../{os.path.relpath(outside, '/')}/victim.ply",
+            "symlinked file": f"{run}/link.ply",
+            "symlinked directory": f"{run}/up/victim.ply",
+            "1 MB name": "a" * (1 << 20) + ".ply",
+        }
+        for what, name in crafted.items():
+            for service in (save, save_octomap):
+                ext_name = name if service is save else name[: -len(".ply")] + ".bt"
+                reply = service(ext_name, True)
+                self.assertFalse(reply.success, f"{what}: {reply.message}")
+                self.assertEqual(reply.written_path, "")
+                self.assertLess(len(reply.message), 400, what)
+        with open(victim) as f:
+            self.assertEqual(f.read(), "precious")
+        self.assertEqual(sorted(os.listdir(outside)), ["victim.txt"])
+        self.assertEqual(sorted(os.listdir(os.path.join(out_dir, run))), ["link.bt", "link.ply", "up"])
 
     def test_2a_slice_distance_is_the_clearance_of_the_slice(self) -> None:
         # ~slice_distance: one point per known slice cell, its distance the exact Euclidean
@@ -140,9 +189,10 @@ class TsdfRoomTest(unittest.TestCase):
         self.assertLess(float(np.percentile(error, 99)), 0.044)
         rospy.wait_for_service("/tsdf/save_octomap", 5.0)
         save = rospy.ServiceProxy("/tsdf/save_octomap", SaveMap)
-        path = os.path.join(tempfile.mkdtemp(), "room.bt")
-        reply = save(path)
+        reply = save(f"run-{os.getpid()}-{time.time_ns()}/room.bt", False)
         self.assertTrue(reply.success, reply.message)
+        path = reply.written_path
+        self.assertTrue(path.startswith(rospy.get_param("/tsdf/output_dir") + "/"), path)
         with open(path, "rb") as f:
             self.assertTrue(f.readline().startswith(b"# Octomap OcTree binary file"))
 

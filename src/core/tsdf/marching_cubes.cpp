@@ -223,6 +223,12 @@ void TriangleMesh::append(const TriangleMesh& other) {
 std::string TriangleMesh::writePly(const std::string& path) const {
   std::ofstream out(path, std::ios::binary);
   if (!out) return "cannot open " + path + " for writing";
+  writePly(out);
+  out.flush();
+  return out ? std::string() : "write to " + path + " failed";
+}
+
+void TriangleMesh::writePly(std::ostream& out) const {
   out << "ply\nformat binary_little_endian 1.0\ncomment downstream_perception TSDF mesh (m)\n"
       << "element vertex " << vertices.size()
       << "\nproperty float x\nproperty float y\nproperty float z\n"
@@ -238,8 +244,6 @@ std::string TriangleMesh::writePly(const std::string& path) const {
     out.write(reinterpret_cast<const char*>(&three), 1);
     out.write(reinterpret_cast<const char*>(&triangles[3 * t]), 3 * sizeof(std::uint32_t));
   }
-  out.flush();
-  return out ? std::string() : "write to " + path + " failed";
 }
 
 TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) {

@@ -93,6 +93,10 @@ std::string OccupancyOctree::writeBinary(const std::string& path) const {
   return tree_->writeBinary(path) ? std::string() : "could not write " + path;
 }
 
+bool OccupancyOctree::writeBinary(std::ostream& out) const {
+  return tree_->writeBinaryConst(out);
+}
+
 void OccupancyOctree::clear() {
   tree_->clear();
 }

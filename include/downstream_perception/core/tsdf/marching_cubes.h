@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,8 @@ struct TriangleMesh {
   void append(const TriangleMesh& other);
   /// Binary little-endian PLY with vertex normals. Returns an empty string or the reason.
   std::string writePly(const std::string& path) const;
+  /// The same PLY into a stream (a service writes it through an OutputDirectory).
+  void writePly(std::ostream& out) const;
 };
 
 /// Mesh of the cubes whose lowest corner lies in `block` (corners need weight > min_weight).

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,8 @@ class OccupancyOctree {
   std::size_t memoryBytes() const;
   /// Binary .bt (maximum-likelihood occupancy). Empty string or the reason.
   std::string writeBinary(const std::string& path) const;
+  /// The same .bt into a stream (a service writes it through an OutputDirectory).
+  bool writeBinary(std::ostream& out) const;
   void clear();
   const OctreeConfig& config() const { return config_; }
 
