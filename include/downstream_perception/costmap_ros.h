@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "downstream_perception/CostmapConfig.h"
+#include "downstream_perception/clock_jump.h"
 #include "downstream_perception/costmap_publisher.h"
 #include "downstream_perception/costmap_ros_config.h"
 #include "downstream_perception/layered_costmap.h"
@@ -38,6 +39,8 @@ class CostmapRos {
   void loadPlugins();
   void reconfigure(CostmapConfig& cfg, std::uint32_t level);
   void updateTimerCallback(const ros::TimerEvent& event);
+  /// Resets what depends on time when the ROS clock went back.
+  void watchClock(const ros::SteadyTimerEvent&);
   bool robotPose(double* x, double* y, double* yaw);
   bool clearService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -65,10 +68,12 @@ class CostmapRos {
   bool reconfigure_started_ = false;
 
   ros::Timer update_timer_;
+  ros::SteadyTimer clock_watch_;
   std::mutex update_mutex_;  ///< one update at a time even on a multi-threaded queue
   std::size_t updates_skipped_busy_ = 0;
   CellBounds unpublished_;  ///< cells redrawn since the last publish
   ros::Time last_publish_;
+  ClockJumpDetector clock_jump_;
   ros::Time last_update_;
   RunningStats update_time_ms_;
   RunningStats update_period_s_;

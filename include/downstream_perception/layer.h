@@ -54,6 +54,9 @@ class Layer {
   virtual void activate() {}
   virtual void deactivate() {}
   virtual void onFootprintChanged() {}
+  /// The ROS clock went back (a looped bag, a restarted simulator): forget stamps and clocks
+  /// kept from the old timeline (the map itself stays).
+  virtual void onClockJump() {}
   /// Fills a diagnostics status (summary level + key/values). Called at the diagnostics rate.
   virtual void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 

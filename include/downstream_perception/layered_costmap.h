@@ -43,6 +43,8 @@ class LayeredCostmap {
   bool isRolling() const { return rolling_window_; }
   /// Resets the master and every layer.
   void resetLayers();
+  /// Tells every layer that the ROS clock went back.
+  void onClockJump();
 
   Costmap& costmap() { return master_; }
   const Costmap& costmap() const { return master_; }

@@ -38,8 +38,7 @@ bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* met
 /// checkCloudLayout, which gave x_offset. Reads through the checked row_step and point_step only,
 /// so no field offset of the message can take it outside the data.
 template <class Visitor>
-void forEachCloudPoint(const sensor_msgs::PointCloud2& msg, std::size_t x_offset,
-                       Visitor&& visit) {
+void forEachCloudPoint(const sensor_msgs::PointCloud2& msg, std::size_t x_offset, Visitor&& visit) {
   for (std::size_t row = 0; row < msg.height; ++row) {
     const std::uint8_t* p = msg.data.data() + row * msg.row_step + x_offset;
     for (std::size_t k = 0; k < msg.width; ++k, p += msg.point_step) {

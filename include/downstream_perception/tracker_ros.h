@@ -21,6 +21,7 @@
 
 #include "downstream_perception/DetectedObjectArray.h"
 #include "downstream_perception/TrackerNodeConfig.h"
+#include "downstream_perception/clock_jump.h"
 #include "downstream_perception/core/tracking/tracker.h"
 #include "downstream_perception/running_stats.h"
 #include "downstream_perception/track_markers.h"
@@ -42,6 +43,8 @@ class TrackerRos {
   /// whole message must be dropped.
   bool toCore(const DetectedObjectArray& msg, std::vector<Detection>* out, std::string* why);
   void publish(const std_msgs::Header& header);
+  /// Resets the tracks and tf when the ROS clock went back.
+  void watchClock(const ros::SteadyTimerEvent&);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void reject(const std::string& reason, const std::string& detail);
 
@@ -69,6 +72,8 @@ class TrackerRos {
   TrackerStats last_;
   std::size_t frames_ = 0;
   std::map<std::string, std::size_t> rejected_;
+  ClockJumpDetector clock_jump_;
+  ros::SteadyTimer clock_watch_;
   RunningStats step_us_;
   std::vector<std::string> config_errors_;
 };

@@ -103,7 +103,8 @@ class TsdfRos {
   double slice_distance_max_m_ = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
   TsdfSliceStats slice_stats_;
   ros::ServiceServer save_service_;
-  OutputDirectory output_directory_{defaultOutputDirectory()};  ///< ~output_dir: services write here
+  OutputDirectory output_directory_{
+      defaultOutputDirectory()};  ///< ~output_dir: services write here
   ros::ServiceServer clear_service_;
   ros::Timer mesh_timer_;
   diagnostic_updater::Updater diagnostics_;

@@ -338,6 +338,15 @@ void LogOddsObstacleLayer::shiftOrigin(int dx, int dy) {
   }
 }
 
+void LogOddsObstacleLayer::onClockJump() {
+  {
+    std::lock_guard<std::mutex> lock(grid_mutex_);
+    last_decay_ = ros::Time();  // decay restarts from the new timeline's next update
+    last_track_clearing_ = ros::Time();
+  }
+  track_inbox_.onClockJump();
+}
+
 void LogOddsObstacleLayer::reset() {
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);

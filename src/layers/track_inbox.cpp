@@ -141,6 +141,12 @@ FreshTracks TrackInbox::fresh(const ros::Time& now) {
   return out;
 }
 
+void TrackInbox::onClockJump() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  tracks_.clear();
+  stamp_ = ros::Time();
+}
+
 void TrackInbox::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   tracks_.clear();

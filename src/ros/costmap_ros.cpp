@@ -36,6 +36,9 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   clear_service_ = pnh_.advertiseService("clear", &CostmapRos::clearService, this);
   update_timer_ = nh_.createTimer(ros::Duration(1.0 / config_.update_frequency),
                                   &CostmapRos::updateTimerCallback, this);
+  // On the steady clock: a ROS-clock timer is what a jump of the ROS clock may hold up.
+  clock_watch_ =
+      nh_.createSteadyTimer(ros::WallDuration(kClockWatchPeriodS), &CostmapRos::watchClock, this);
   // Last: its first callback applies the YAML values again (a no-op) and from then on every
   // live change goes through reconfigure().
   reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
@@ -52,6 +55,7 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 CostmapRos::~CostmapRos() {
   reconfigure_server_.reset();
   update_timer_.stop();
+  clock_watch_.stop();
   // Layers hold subscriptions that call back into them: drop them before the loader goes.
   layered_costmap_.reset();
 }
@@ -208,6 +212,17 @@ bool CostmapRos::robotPose(double* x, double* y, double* yaw) {
   }
 }
 
+void CostmapRos::watchClock(const ros::SteadyTimerEvent&) {
+  if (clock_jump_.check(ros::Time::now(), "costmap") == 0.0) return;
+  {
+    std::lock_guard<std::mutex> busy(update_mutex_);
+    restartTf(*tf_buffer_, tf_listener_, nh_);
+    layered_costmap_->onClockJump();
+    last_publish_ = ros::Time();  // else nothing is published until the clock passes it again
+  }
+  diagnostics_.force_update();  // the updater, too, waits for its next (old-timeline) time
+}
+
 void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
   std::unique_lock<std::mutex> busy(update_mutex_, std::try_to_lock);
   if (!busy.owns_lock()) {
@@ -280,6 +295,7 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("full grids published", publisher_ ? publisher_->fullGridsPublished() : 0);
   status.add("updates published", publisher_ ? publisher_->updatesPublished() : 0);
   status.add("clears (~clear)", clears_);
+  status.add("clock jumps back", clock_jump_.jumps());
   addConfigErrors(status, errors);
   status.add("footprint inscribed radius (m)", layered_costmap_->inscribedRadius());
   status.add("footprint circumscribed radius (m)", layered_costmap_->circumscribedRadius());

@@ -64,6 +64,11 @@ void LayeredCostmap::resetLayers() {
   full_redraw_ = true;
 }
 
+void LayeredCostmap::onClockJump() {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  for (auto& plugin : plugins_) plugin->onClockJump();
+}
+
 bool LayeredCostmap::isCurrent() const {
   for (const auto& plugin : plugins_) {
     if (plugin->isEnabled() && !plugin->isCurrent()) return false;

@@ -72,11 +72,11 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg, std::size_t* x
     why << "point_step " << msg.point_step << " is smaller than the x, y, z fields (x at offset "
         << x->offset << ")";
   } else if (U64{msg.width} * msg.point_step > msg.row_step) {
-    why << "row_step " << msg.row_step << " < width * point_step = "
-        << U64{msg.width} * msg.point_step;
+    why << "row_step " << msg.row_step
+        << " < width * point_step = " << U64{msg.width} * msg.point_step;
   } else if (U64{msg.row_step} * msg.height != msg.data.size()) {
-    why << "data holds " << msg.data.size() << " bytes, row_step * height = "
-        << U64{msg.row_step} * msg.height;
+    why << "data holds " << msg.data.size()
+        << " bytes, row_step * height = " << U64{msg.row_step} * msg.height;
   } else if (x_offset != nullptr) {
     *x_offset = x->offset;
   }

@@ -68,12 +68,30 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     filter_->registerFailureCallback(boost::bind(&TrackerRos::onTfFailure, this,
                                                  boost::placeholders::_1, boost::placeholders::_2));
   }
+  // On the steady clock: a jump of the ROS clock must not hold up its own detection.
+  clock_watch_ =
+      nh_.createSteadyTimer(ros::WallDuration(kClockWatchPeriodS), &TrackerRos::watchClock, this);
   ROS_INFO("tracker: %s mode, tracking in '%s', detections on %s", mode.c_str(),
            image_mode_ ? "the detections' frame" : tracking_frame_.c_str(),
            ros::names::resolve(nh_.getNamespace(), "detections").c_str());
 }
 
+void TrackerRos::watchClock(const ros::SteadyTimerEvent&) {
+  if (clock_jump_.check(ros::Time::now(), "tracker") == 0.0) return;
+  if (filter_) filter_->clear();  // messages waiting for old-timeline transforms
+  if (tf_buffer_) restartTf(*tf_buffer_, tf_listener_, nh_);
+  {
+    // Tracks carry ages and stamps of the old timeline; the new one's frames are older than
+    // them. Ids keep counting, so no id of the old timeline comes back for another object.
+    std::lock_guard<std::mutex> lock(mutex_);
+    tracker_->reset();
+  }
+  diagnostics_.force_update();  // outside mutex_ (diagnose() takes it): the updater, too,
+                                // waits for its next (old-timeline) time
+}
+
 TrackerRos::~TrackerRos() {
+  clock_watch_.stop();
   reconfigure_server_.reset();
   filter_.reset();
   subscriber_.reset();
@@ -243,6 +261,7 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     rejected += count;
   }
   status.add("frames", frames_);
+  status.add("clock jumps back (tracks reset)", clock_jump_.jumps());
   status.add("tracks alive", last_.tracks);
   status.add("tracks confirmed", last_.confirmed);
   status.add("detections (total)", total_.detections);

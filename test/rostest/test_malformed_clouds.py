@@ -41,7 +41,7 @@ def malformed_clouds(stamp: rospy.Time) -> dict[str, PointCloud2]:
         return c
 
     def fields(offsets: tuple[int, int, int], datatype: int = PointField.FLOAT32, count: int = 1):
-        return [PointField(n, o, datatype, count) for n, o in zip("xyz", offsets)]
+        return [PointField(n, o, datatype, count) for n, o in zip("xyz", offsets, strict=True)]
 
     def setattrs(**values):  # type: ignore[no-untyped-def]
         return lambda c: [setattr(c, k, v) for k, v in values.items()]
@@ -106,9 +106,7 @@ class MalformedCloudsTest(unittest.TestCase):
 
     def count(self, status_suffix: str, key_prefix: str) -> int:
         return sum(
-            int(float(v))
-            for k, v in self.values(status_suffix).items()
-            if k.startswith(key_prefix)
+            int(float(v)) for k, v in self.values(status_suffix).items() if k.startswith(key_prefix)
         )
 
     def test_every_consumer_refuses_every_layout_and_keeps_working(self) -> None:
@@ -139,7 +137,9 @@ class MalformedCloudsTest(unittest.TestCase):
             self.pub.publish(good)
             rospy.sleep(0.2)
         self.assertTrue(
-            wait_until(lambda: self.costmap.received and self.costmap.cell(1.55, 0.05) == 100, 15.0),
+            wait_until(
+                lambda: self.costmap.received and self.costmap.cell(1.55, 0.05) == 100, 15.0
+            ),
             "the wall 1.5 m ahead never became lethal",
         )
         self.assertTrue(

@@ -151,7 +151,9 @@ class TsdfRoomTest(unittest.TestCase):
         with open(victim) as f:
             self.assertEqual(f.read(), "precious")
         self.assertEqual(sorted(os.listdir(outside)), ["victim.txt"])
-        self.assertEqual(sorted(os.listdir(os.path.join(out_dir, run))), ["link.bt", "link.ply", "up"])
+        self.assertEqual(
+            sorted(os.listdir(os.path.join(out_dir, run))), ["link.bt", "link.ply", "up"]
+        )
 
     def test_2a_slice_distance_is_the_clearance_of_the_slice(self) -> None:
         # ~slice_distance: one point per known slice cell, its distance the exact Euclidean

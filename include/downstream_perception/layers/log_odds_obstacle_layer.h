@@ -46,6 +46,7 @@ class LogOddsObstacleLayer : public Layer {
   void matchSize() override;
   void shiftOrigin(int dx, int dy) override;
   void reset() override;
+  void onClockJump() override;
   void activate() override;
   void deactivate() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;

@@ -54,6 +54,9 @@ class TrackInbox {
   /// dropped and counted as expired).
   FreshTracks fresh(const ros::Time& now);
   void clear();
+  /// Forgets the tracks and the stamp they carried (the clock went back: an array of the new
+  /// timeline is older than it).
+  void onClockJump();
   /// Counts, rejections by reason and transform ages, each key prefixed with `prefix`.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status,
                 const std::string& prefix = "") const;

@@ -33,6 +33,7 @@ class TrackedObstacleLayer : public Layer {
   void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
   void matchSize() override;
   void reset() override;
+  void onClockJump() override { inbox_.onClockJump(); }
   void activate() override;
   void deactivate() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;

@@ -99,8 +99,7 @@ std::string OutputDirectory::checkName(const std::string& name,
     }
   }
   if (name.front() == '/') {
-    return "name " + shown + " is absolute: give a name inside the output directory " +
-           directory_;
+    return "name " + shown + " is absolute: give a name inside the output directory " + directory_;
   }
   const std::vector<std::string> parts = components(name);
   if (parts.empty()) return "name " + shown + " names no file";
@@ -145,8 +144,7 @@ OutputFileResult OutputDirectory::write(const std::string& name, const std::stri
       return result;
     }
     // O_NOFOLLOW: a symlinked subdirectory (to /etc, say) is refused, not entered.
-    Fd sub(::openat(dir.get(), parts[k].c_str(),
-                    O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+    Fd sub(::openat(dir.get(), parts[k].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
     if (!sub.valid()) {
       result.error = errnoText(directory_ + "/" + relative + " is not a plain directory");
       return result;
@@ -167,8 +165,8 @@ OutputFileResult OutputDirectory::write(const std::string& name, const std::stri
     }
   }
   static std::atomic<unsigned> counter{0};
-  const std::string temporary = "." + leaf.substr(0, 200) + ".tmp-" +
-                                std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  const std::string temporary = "." + leaf.substr(0, 200) + ".tmp-" + std::to_string(::getpid()) +
+                                "-" + std::to_string(counter++);
   Fd out(::openat(dir.get(), temporary.c_str(),
                   O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (!out.valid()) {

@@ -35,8 +35,8 @@ class OutputDirectoryTest : public ::testing::Test {
   /// Everything in the output directory (a failed or refused write must leave nothing behind).
   std::size_t entries() const {
     if (!fs::exists(dir_)) return 0;
-    return static_cast<std::size_t>(std::distance(fs::recursive_directory_iterator(dir_),
-                                                  fs::recursive_directory_iterator()));
+    return static_cast<std::size_t>(
+        std::distance(fs::recursive_directory_iterator(dir_), fs::recursive_directory_iterator()));
   }
 
   fs::path root_, dir_, victim_;

@@ -19,7 +19,7 @@ struct OutputFileResult {
 
 class OutputDirectory {
  public:
-  static constexpr std::size_t kMaxNameBytes = 1024;     ///< the whole relative name
+  static constexpr std::size_t kMaxNameBytes = 1024;      ///< the whole relative name
   static constexpr std::size_t kMaxComponentBytes = 255;  ///< one path component (NAME_MAX)
 
   /// `directory` must be absolute; it is created (with its parents) on the first write.
