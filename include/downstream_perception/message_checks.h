@@ -39,6 +39,7 @@ bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* met
 /// so no field offset of the message can take it outside the data.
 template <class Visitor>
 void forEachCloudPoint(const sensor_msgs::PointCloud2& msg, std::size_t x_offset, Visitor&& visit) {
+  if (msg.width == 0) return;  // an empty cloud may still claim 2^32 - 1 rows of nothing
   for (std::size_t row = 0; row < msg.height; ++row) {
     const std::uint8_t* p = msg.data.data() + row * msg.row_step + x_offset;
     for (std::size_t k = 0; k < msg.width; ++k, p += msg.point_step) {
@@ -48,6 +49,11 @@ void forEachCloudPoint(const sensor_msgs::PointCloud2& msg, std::size_t x_offset
     }
   }
 }
+
+/// The cloud with its rows packed (row_step = width * point_step), for code that walks a cloud
+/// as one run of points (PointCloud2Iterator, tf2::doTransform): with padded rows such a walk
+/// steps over the end of the data. Returns the message itself when already packed.
+sensor_msgs::PointCloud2ConstPtr packedCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
 
 /// A frame, a finite position and a finite unit quaternion (|q| within 1 %: rounding in a
 /// hand-written goal is forgiven, a zero quaternion is not).

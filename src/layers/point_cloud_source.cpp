@@ -45,7 +45,9 @@ void PointCloudSource::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
 
   Observation obs;
   obs.stamp = msg->header.stamp;
-  for (std::uint32_t row = 0; row < msg->height; ++row) {
+  // An empty cloud may still claim 2^32 - 1 rows of nothing: no loop over them.
+  const std::uint32_t rows = msg->width == 0 ? 0 : msg->height;
+  for (std::uint32_t row = 0; row < rows; ++row) {
     beamsFromCloud(integrator_, config_.cloud,
                    msg->data.data() + static_cast<std::size_t>(row) * msg->row_step + x_offset,
                    msg->width, msg->point_step, grid_from_sensor, &obs.beams, &obs.decisions);

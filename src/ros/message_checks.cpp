@@ -36,7 +36,14 @@ std::string checkScan(const sensor_msgs::LaserScan& msg) {
       return s.str();
     }
   }
-  if (!std::isfinite(msg.time_increment)) return "time_increment is not finite";
+  // A sweep is a fraction of a second; ros::Duration throws beyond its 32-bit seconds.
+  constexpr double kMaxSweepS = 10.0;
+  if (!std::isfinite(msg.time_increment) ||
+      std::abs(static_cast<double>(msg.time_increment)) * static_cast<double>(msg.ranges.size()) >
+          kMaxSweepS) {
+    return "time_increment " + std::to_string(msg.time_increment) + " s times " +
+           std::to_string(msg.ranges.size()) + " beams is not a sweep of at most 10 s";
+  }
   if (!msg.intensities.empty() && msg.intensities.size() != msg.ranges.size()) {
     return std::to_string(msg.intensities.size()) + " intensities for " +
            std::to_string(msg.ranges.size()) + " ranges";
@@ -81,6 +88,32 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg, std::size_t* x
     *x_offset = x->offset;
   }
   return why.str();
+}
+
+sensor_msgs::PointCloud2ConstPtr packedCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  const std::size_t row_bytes = static_cast<std::size_t>(msg->width) * msg->point_step;
+  if (msg->width == 0 || msg->height == 0) {
+    sensor_msgs::PointCloud2Ptr empty(new sensor_msgs::PointCloud2(*msg));
+    empty->width = empty->height = empty->row_step = 0;  // no rows of nothing
+    empty->data.clear();
+    return empty;
+  }
+  if (msg->row_step == row_bytes) return msg;
+  sensor_msgs::PointCloud2Ptr packed(new sensor_msgs::PointCloud2);
+  packed->header = msg->header;
+  packed->height = msg->height;
+  packed->width = msg->width;
+  packed->fields = msg->fields;
+  packed->is_bigendian = msg->is_bigendian;
+  packed->point_step = msg->point_step;
+  packed->row_step = static_cast<std::uint32_t>(row_bytes);
+  packed->is_dense = msg->is_dense;
+  packed->data.resize(row_bytes * msg->height);
+  for (std::size_t row = 0; row < msg->height; ++row) {
+    std::memcpy(packed->data.data() + row * row_bytes, msg->data.data() + row * msg->row_step,
+                row_bytes);
+  }
+  return packed;
 }
 
 std::string checkPose(const geometry_msgs::PoseStamped& msg) {

@@ -130,7 +130,7 @@ void PlanningFrameRelay::onCloud(Input* input, const sensor_msgs::PointCloud2Con
   sensor_msgs::PointCloud2 out;
   try {
     // Released by the MessageFilter: the transform at the stamp exists.
-    tf2::doTransform(*msg, out,
+    tf2::doTransform(*packedCloud(msg), out,
                      tf_.lookupTransform(planning_frame_, msg->header.frame_id, msg->header.stamp));
   } catch (const tf2::TransformException& e) {
     onTfFailure(input, msg->header.frame_id, msg->header.stamp, e.what());

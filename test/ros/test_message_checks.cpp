@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <sensor_msgs/image_encodings.h>
+#include <boost/make_shared.hpp>
 
 #include <cmath>
 #include <cstdint>
@@ -252,4 +253,38 @@ TEST(CheckPose, RefusesNonFiniteAndZeroQuaternions) {
   p.pose.orientation.w = 1.0;
   p.header.frame_id.clear();
   EXPECT_NE(checkPose(p), "");
+}
+
+TEST(PackedCloud, PacksPaddedRowsSoALinearWalkStaysInTheData) {
+  const auto padded = boost::make_shared<sensor_msgs::PointCloud2>(xyziCloud(3, 2, 5));
+  const sensor_msgs::PointCloud2ConstPtr packed = packedCloud(padded);
+  ASSERT_EQ(checkCloudLayout(*packed), "");
+  EXPECT_EQ(packed->row_step, 48u);
+  EXPECT_EQ(packed->data.size(), 96u);  // a PointCloud2Iterator walks exactly 6 points
+  std::vector<float> xs;
+  forEachCloudPoint(*packed, 0, [&](float x, float, float) { xs.push_back(x); });
+  EXPECT_EQ(xs, (std::vector<float>{0, 1, 2, 3, 4, 5}));
+  const auto tight = boost::make_shared<sensor_msgs::PointCloud2>(xyziCloud(3, 2));
+  EXPECT_EQ(packedCloud(tight).get(), tight.get());  // already packed: no copy
+}
+
+TEST(PackedCloud, AnEmptyCloudWithHugeHeightIsEmpty) {
+  auto empty = boost::make_shared<sensor_msgs::PointCloud2>(xyziCloud(0, 1));
+  empty->height = 0xFFFFFFFFu;  // rows of nothing: once a 4-billion-row loop
+  empty->row_step = 0;
+  ASSERT_EQ(checkCloudLayout(*empty), "");
+  std::size_t visited = 0;
+  forEachCloudPoint(*empty, 0, [&](float, float, float) { ++visited; });
+  EXPECT_EQ(visited, 0u);
+  EXPECT_EQ(packedCloud(empty)->height, 0u);
+}
+
+TEST(CheckScan, RefusesASweepLongerThanTenSeconds) {
+  sensor_msgs::LaserScan s = scan(100);
+  s.time_increment = 1e-4f;
+  EXPECT_EQ(checkScan(s), "");
+  s.time_increment = 1e18f;  // ros::Duration would throw from the callback
+  EXPECT_NE(checkScan(s), "");
+  s.time_increment = -2.0f;
+  EXPECT_NE(checkScan(s), "");
 }
