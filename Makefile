@@ -2,13 +2,15 @@
 #   make demo   installs what is missing, builds, runs the synthetic demo headless, writes
 #               out/demo.png (rviz screenshot) and out/demo_report.md
 #   make test   runs every test (gtest, rostest, pytest); exits non-zero if any fails
+# Hardening (README "Hardening and CI"):
+#   make test-sanitize   ASan+UBSan build (.ws-san) running the gtests and the pytests
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build test demo bench bench-open3d lint clean
+.PHONY: help deps build test test-sanitize demo bench bench-open3d lint clean
 
 help:
-	@echo "make demo | make test | make bench | make bench-open3d | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make test-sanitize | make bench | make bench-open3d | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -19,6 +21,9 @@ build: deps
 
 test: build
 	@tools/run_tests.sh
+
+test-sanitize: deps
+	@tools/test_sanitize.sh
 
 demo: build
 	@source tools/env.sh && source_workspace && python3 scripts/demo.py --out out
@@ -36,4 +41,4 @@ lint:
 	@tools/lint.sh
 
 clean:
-	rm -rf .ws out
+	rm -rf .ws .ws-san out
