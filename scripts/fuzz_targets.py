@@ -638,14 +638,22 @@ def garbage_inflation_cost(a: dict[str, Any], r: Any) -> str | None:
     d, cfg = a["distance"], a["config"]
     if valid or not (math.isfinite(d) and d >= 0):
         return None  # no promise for invalid settings (inflate() is where they must be refused)
+
     # costmap_2d: nothing beyond the inflation radius, even inside a larger inscribed radius.
+    # Near either radius the C++ allows a rounding tolerance: no claim there.
+    def margin(v: float) -> float:
+        return abs(v) * 1e-6 + 1e-9
+
+    r, ins = cfg["inflation_radius"], cfg["inscribed_radius"]
     if d == 0:
         return None if cost == 254 else f"cost {cost} at distance 0"
-    if d > cfg["inflation_radius"]:
+    if d > r + margin(r):
         return None if cost == 0 else f"cost {cost} beyond the inflation radius"
-    if d <= cfg["inscribed_radius"]:
+    if d < r - margin(r) and d < ins - margin(ins):
         return None if cost == 253 else f"cost {cost} inside the inscribed radius"
-    return None if cost <= 252 else f"cost {cost} outside the inscribed radius"
+    if ins + margin(ins) < d < r - margin(r) and cost > 252:
+        return f"cost {cost} outside the inscribed radius"
+    return None
 
 
 def gen_inflate(rng: np.random.Generator) -> dict[str, Any]:
