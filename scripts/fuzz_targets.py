@@ -918,7 +918,7 @@ def call_prediction(a: dict[str, Any]) -> Any:
     c = core()
     track = make_track(a)
     config = configure(c.PredictionConfig(), a["config"])
-    valid = track.validate() + config.validate()
+    valid = "; ".join(why for why in (track.validate(), config.validate()) if why)
     op = a["op"]
     if op == "uncertainty":
         return valid, c.uncertainty_radius(track, a["dt"], config)
