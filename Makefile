@@ -2,13 +2,20 @@
 #   make demo   installs what is missing, builds, runs the synthetic demo headless, writes
 #               out/demo.png (rviz screenshot) and out/demo_report.md
 #   make test   runs every test (gtest, rostest, pytest); exits non-zero if any fails
+# Hardening (README "Hardening and CI"):
+#   make test-sanitize   ASan+UBSan build (.ws-san) running the gtests and the pytests
+#   make fuzz            fixed-seed fuzz campaign (FUZZ_CASES=20000 by default, FUZZ_SEED=17)
+#   make fuzz-sanitize   the binding part of that campaign against the sanitized module
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build test demo bench bench-open3d lint clean
+.PHONY: help deps build test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d lint clean
+
+FUZZ_CASES ?= 20000
+FUZZ_SEED ?= 17
 
 help:
-	@echo "make demo | make test | make bench | make bench-open3d | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -19,6 +26,19 @@ build: deps
 
 test: build
 	@tools/run_tests.sh
+
+test-sanitize: deps
+	@tools/test_sanitize.sh
+
+# The message-check driver is built only here (EXCLUDE_FROM_ALL in CMakeLists.txt).
+fuzz: build
+	@source tools/env.sh && cd "$$WS" && catkin_make -j2 fuzz_message_checks > "$$WS/fuzz_build.log" 2>&1 \
+		|| { tail -30 "$$WS/fuzz_build.log"; echo "fuzz: building fuzz_message_checks failed"; exit 1; }
+	@source tools/env.sh && source_workspace && \
+		python3 scripts/fuzz.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED) --out out/fuzz
+
+fuzz-sanitize: deps
+	@tools/fuzz_sanitize.sh --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
 
 demo: build
 	@source tools/env.sh && source_workspace && python3 scripts/demo.py --out out
@@ -36,4 +56,4 @@ lint:
 	@tools/lint.sh
 
 clean:
-	rm -rf .ws out
+	rm -rf .ws .ws-san out

@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# ASan + UBSan: builds the core library, the gtests and the Python module in their own catkin
+# workspace (.ws-san, so .ws keeps its Release build), then runs every gtest and every pytest
+# with the sanitizer runtime. Prints one closing line "sanitize: N passed, M failed" and exits
+# non-zero on any failed test, missing result or sanitizer report. rostests are not run here.
+# With --build-only it only builds (for tools/fuzz_sanitize.sh).
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
+SAN_WS="$REPO/.ws-san"
+SAN_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+RESULTS="$SAN_WS/results"
+mkdir -p "$SAN_WS/src" "$ROS_HOME"
+ln -sfn "$REPO" "$SAN_WS/src/downstream_perception"
+cd "$SAN_WS"
+if [[ -f build/CMakeCache.txt ]] && ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" build/CMakeCache.txt; then
+  rm -rf build devel # a cache configured with another python (pitfall P14)
+fi
+
+# Only the targets the tests need (the nodelets and rostests are not built: 2 cores in CI);
+# gencfg gives the pytests the dynamic_reconfigure Python modules.
+# RelWithDebInfo at -O1: readable reports, and pybind11 adds no LTO in that configuration.
+start=$SECONDS
+if ! catkin_make -j2 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=ON \
+  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF \
+  "-DCMAKE_CXX_FLAGS=$SAN_FLAGS" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
+  "-DCMAKE_EXE_LINKER_FLAGS=$SAN_FLAGS" "-DCMAKE_SHARED_LINKER_FLAGS=$SAN_FLAGS" \
+  "-DCMAKE_MODULE_LINKER_FLAGS=$SAN_FLAGS" \
+  downstream_perception_core test_core _core downstream_perception_gencfg > "$SAN_WS/build.log" 2>&1; then
+  grep -E 'error|Error' "$SAN_WS/build.log" | head -40 || true
+  tail -40 "$SAN_WS/build.log"
+  echo "sanitize: 0 passed, 1 failed (build failed; log: $SAN_WS/build.log)"
+  exit 1
+fi
+echo "sanitize: build ok in $((SECONDS - start)) s (log: $SAN_WS/build.log)"
+[[ "${1:-}" == "--build-only" ]] && exit 0 # tools/fuzz_sanitize.sh
+
+rm -rf "$RESULTS"
+mkdir -p "$RESULTS"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+status=0
+
+# gtests: leaks in our own C++ are real, so LeakSanitizer stays on.
+ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
+  ./devel/lib/downstream_perception/test_core --gtest_output="xml:$RESULTS/gtest-test_core.xml" \
+  > "$RESULTS/gtest.log" 2>&1 || status=1
+grep -E '^\[  (PASSED|FAILED) ' "$RESULTS/gtest.log" || true
+
+# pytests: Python is not instrumented, so the runtime is preloaded; CPython leaks by design.
+source_workspace_at() {
+  set +u
+  # shellcheck disable=SC1091
+  source "$1/devel/setup.bash"
+  set -u
+}
+source_workspace_at "$SAN_WS"
+python=/usr/bin/python3
+[[ -x "$WS/py-venv/bin/python" ]] && python="$WS/py-venv/bin/python" # motmetrics (make deps)
+preload="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libubsan.so)"
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
+module="$(LD_PRELOAD="$preload" "$python" -c \
+  'import downstream_perception._core as c; print(c.__file__)' 2> "$RESULTS/import.log")" || {
+  cat "$RESULTS/import.log"
+  echo "sanitize: 0 passed, 1 failed (the sanitized module does not import)"
+  exit 1
+}
+if [[ "$module" != "$SAN_WS/devel/"* ]] || ! nm -D "$module" | grep -q __asan_init; then
+  echo "sanitize: 0 passed, 1 failed (python imports $module, not the sanitized module)"
+  exit 1
+fi
+echo "sanitize: python imports $module (instrumented)"
+(cd "$REPO" && LD_PRELOAD="$preload" "$python" -m pytest -q -p no:cacheprovider test/pytest \
+  --junitxml="$RESULTS/pytest.xml") > "$RESULTS/pytest.log" 2>&1 || status=1
+tail -1 "$RESULTS/pytest.log"
+
+summary_status=0
+python3 "$REPO/tools/test_summary.py" "$RESULTS" --label sanitize \
+  --expect gtest-test_core.xml --expect pytest.xml \
+  --sanitizer-log "$RESULTS/gtest.log" --sanitizer-log "$RESULTS/pytest.log" || summary_status=$?
+if ((status != 0 && summary_status == 0)); then
+  echo "sanitize: a test process failed without a failing test case (see $RESULTS/*.log)"
+  summary_status=1
+fi
+exit "$summary_status"
