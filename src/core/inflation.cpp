@@ -171,14 +171,16 @@ void Inflator::shift(int dx, int dy) {
   }
   const int nx = geometry_.sizeX();
   const int ny = geometry_.sizeY();
-  if (std::abs(dx) >= nx || std::abs(dy) >= ny) {
+  // 64-bit: std::abs(INT_MIN) is undefined.
+  if (std::abs(std::int64_t{dx}) >= nx || std::abs(std::int64_t{dy}) >= ny) {
     geometry_ = shiftedGeometry(geometry_, dx, dy);
     full_recompute_ = true;
     return;
   }
+  const GridGeometry shifted = shiftedGeometry(geometry_, dx, dy);  // may throw: nothing moved
   shiftGridData(&lethal_, nx, ny, dx, dy, std::uint8_t{0});
   shiftGridData(&costs_, nx, ny, dx, dy, std::uint8_t{0});
-  geometry_ = shiftedGeometry(geometry_, dx, dy);
+  geometry_ = shifted;
   // Bands still pending from an earlier shift move with the content.
   std::vector<CellBounds> moved;
   for (const CellBounds& b : pending_regions_) {

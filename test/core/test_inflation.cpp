@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "downstream_perception/core/inflation.h"
@@ -308,4 +309,28 @@ TEST(Inflator, SmallShiftRecomputesOnlyTheEdges) {
   const InflationStats stats = inflator.update(&master, everything(master.geometry()));
   // The exposed column and the band of radius + 1 columns at the other edge: 8 of 400 columns.
   EXPECT_EQ(stats.cells_recomputed, 8u * 400u);
+}
+
+// Issue 17 item 8: std::abs(INT_MIN) in Inflator::shift is undefined (UBSan); any shift of at
+// least the grid's size must simply recompute everything.
+TEST(Inflator, ExtremeShiftsEqualFullRecomputation) {
+  std::mt19937 rng(37);
+  const GridGeometry g(60, 50, 0.05, 0.0, 0.0);
+  InflationConfig c;
+  c.inflation_radius = 0.3;
+  for (const int d : {std::numeric_limits<int>::min(), std::numeric_limits<int>::max(), -60, 50}) {
+    Costmap master = randomLethalMap(g, 0.01, rng);
+    Inflator inflator(c, g.resolution());
+    inflator.update(&master, everything(g));
+    master.shift(d, 1);
+    inflator.shift(d, 1);
+    const GridGeometry moved = master.geometry();
+    Costmap fresh = randomLethalMap(moved, 0.01, rng);
+    master = fresh;
+    inflator.update(&master, everything(moved));
+    Inflator full(c, moved.resolution());
+    full.update(&fresh, everything(moved));
+    ASSERT_EQ(inflator.costs(), full.costs()) << "shift " << d;
+    ASSERT_EQ(master.cells(), fresh.cells()) << "shift " << d;
+  }
 }
