@@ -381,7 +381,11 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor, "1/m")
       .def_readwrite("inscribed_radius", &InflationConfig::inscribed_radius, "m")
       .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown)
-      .def("validate", &InflationConfig::validate);
+      .def_readonly_static("MAX_RADIUS_CELLS", &InflationConfig::kMaxRadiusCells,
+                           "largest inflation_radius / resolution accepted")
+      .def("validate", py::overload_cast<>(&InflationConfig::validate, py::const_))
+      .def("validate", py::overload_cast<double>(&InflationConfig::validate, py::const_),
+           py::arg("resolution_m"), "Also checks the radius in cells at this resolution.");
   m.def("inflation_cost", &inflationCost, py::arg("distance_m"), py::arg("config"),
         "costmap_2d's cost for a cell at distance_m from the nearest lethal cell.");
   m.def(

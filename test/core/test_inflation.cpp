@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "downstream_perception/core/inflation.h"
 
@@ -242,6 +244,34 @@ TEST(Inflator, RejectsAbsurdConfigs) {
   EXPECT_THROW(Inflator(c, 0.05), std::invalid_argument);
   EXPECT_THROW(Inflator(InflationConfig{}, 0.0), std::invalid_argument);
   EXPECT_TRUE(InflationConfig{}.validate().empty());
+}
+
+// Issue 17 item 8: 0.55 m at 2e-5 m (27,500 cells) took 28 s per update; at 5e-324 m the cost
+// table could not be allocated ("cannot create std::vector larger than max_size()").
+TEST(Inflator, RefusesRadiiOfTooManyCells) {
+  InflationConfig c;  // 0.55 m
+  for (const double res : {2e-5, 5e-324, 1e-200}) {
+    const std::string why = c.validate(res);
+    EXPECT_NE(why.find("cells"), std::string::npos) << res << ": " << why;
+    EXPECT_THROW(Inflator(c, res), std::invalid_argument) << res;
+  }
+  for (const double res : {0.0, -0.05, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    EXPECT_NE(c.validate(res).find("resolution"), std::string::npos) << res;
+    EXPECT_THROW(Inflator(c, res), std::invalid_argument) << res;
+  }
+  // The bound itself is accepted, one cell more is not.
+  c.inflation_radius = InflationConfig::kMaxRadiusCells * 0.05;
+  EXPECT_EQ(c.validate(0.05), "");
+  Inflator at_limit(c, 0.05);
+  EXPECT_EQ(at_limit.radiusCells(), InflationConfig::kMaxRadiusCells);
+  c.inflation_radius = (InflationConfig::kMaxRadiusCells + 1) * 0.01;
+  EXPECT_FALSE(c.validate(0.01).empty());
+  // A radius of 0 fits any resolution; a refused setConfig keeps the old config.
+  c.inflation_radius = 0.0;
+  EXPECT_EQ(c.validate(5e-324), "");
+  Inflator kept(InflationConfig{}, 0.05);
+  EXPECT_THROW(kept.setConfig(InflationConfig{}, 2e-5), std::invalid_argument);
+  EXPECT_EQ(kept.radiusCells(), 11);
 }
 
 TEST(Inflator, RollingWindowShiftsEqualFullRecomputation) {
