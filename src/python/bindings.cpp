@@ -574,6 +574,8 @@ PYBIND11_MODULE(_core, m) {
       "predicted_cells",
       [](const PlanarTrack& track, double age_s, const PredictionConfig& config,
          const GridGeometry& geometry) {
+        const std::string why = validatePrediction(track, age_s, config);
+        if (!why.empty()) throw std::invalid_argument(why);
         std::vector<std::size_t> cells;
         predictedCells(track, age_s, config, geometry, &cells);
         std::vector<CellIndex> xy;
@@ -582,11 +584,15 @@ PYBIND11_MODULE(_core, m) {
         return cellsToArray(xy);
       },
       py::arg("track"), py::arg("age_s"), py::arg("config"), py::arg("geometry"),
-      "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s.");
+      "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s. "
+      "Raises ValueError if the track, age_s or the config is invalid.");
   m.def(
       "recent_cells",
       [](const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
          double max_object_size_m, const GridGeometry& geometry) {
+        const std::string why =
+            recentCellsReason(track, lookback_s, age_s, margin_m, max_object_size_m);
+        if (!why.empty()) throw std::invalid_argument(why);
         std::vector<std::size_t> cells;
         recentCells(track, lookback_s, age_s, margin_m, max_object_size_m, geometry, &cells);
         std::vector<CellIndex> xy;
