@@ -621,6 +621,10 @@ PYBIND11_MODULE(_core, m) {
       .value("METRIC", TrackerConfig::Mode::kMetric)
       .value("IMAGE", TrackerConfig::Mode::kImage);
   tc.def(py::init<>())
+      .def_readonly_static("MAX_BOX_COORDINATE_PX", &TrackerConfig::kMaxBoxCoordinatePx,
+                           "image mode: larger |box coordinates| are rejected (out of range)")
+      .def_readonly_static("MAX_POSITION_M", &TrackerConfig::kMaxPositionM,
+                           "metric mode: larger |position| / size are rejected (out of range)")
       .def_readwrite("mode", &TrackerConfig::mode)
       .def_readwrite("gate_confidence", &TrackerConfig::gate_confidence)
       .def_readwrite("duplicate_confidence", &TrackerConfig::duplicate_confidence)
@@ -640,6 +644,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("detections", &TrackerStats::detections)
       .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score)
       .def_readonly("detections_rejected_invalid", &TrackerStats::detections_rejected_invalid)
+      .def_readonly("detections_rejected_out_of_range",
+                    &TrackerStats::detections_rejected_out_of_range)
       .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass)
       .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass)
       .def_readonly("births", &TrackerStats::births)
