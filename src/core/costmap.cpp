@@ -40,8 +40,10 @@ void Costmap::resetWindow(const CellBounds& window) {
 }
 
 void Costmap::shift(int dx, int dy) {
+  // The new geometry first: if its origin is not finite it throws and nothing has moved.
+  const GridGeometry shifted = shiftedGeometry(geometry_, dx, dy);
   shiftGridData(&cells_, geometry_.sizeX(), geometry_.sizeY(), dx, dy, default_value_);
-  geometry_ = shiftedGeometry(geometry_, dx, dy);
+  geometry_ = shifted;
 }
 
 }  // namespace downstream_perception

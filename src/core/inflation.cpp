@@ -44,6 +44,21 @@ std::string InflationConfig::validate() const {
   return why.str();
 }
 
+std::string InflationConfig::validate(double resolution_m) const {
+  std::string why = validate();
+  if (!why.empty()) return why;
+  std::ostringstream out;
+  if (!std::isfinite(resolution_m) || resolution_m <= 0.0) {
+    out << "resolution must be finite and > 0 m, got " << resolution_m;
+  } else if (inflation_radius / resolution_m > kMaxRadiusCells) {
+    // Compared as doubles: the quotient may be far beyond any int (or +inf).
+    out << "inflation_radius " << inflation_radius << " m is " << inflation_radius / resolution_m
+        << " cells of " << resolution_m << " m, more than the limit of " << kMaxRadiusCells
+        << " cells (at most " << kMaxRadiusCells * resolution_m << " m at this resolution)";
+  }
+  return out.str();
+}
+
 std::uint8_t inflationCost(double distance_m, const InflationConfig& config) {
   if (distance_m == 0.0) return cost::kLethalObstacle;
   // A relative tolerance so a cell exactly on the radius (0.55 m = 11 cells of 0.05 m, which is
@@ -131,12 +146,8 @@ Inflator::Inflator(const InflationConfig& config, double resolution_m) {
 }
 
 void Inflator::setConfig(const InflationConfig& config, double resolution_m) {
-  const std::string why = config.validate();
-  if (!why.empty()) throw std::invalid_argument(why);
-  if (!std::isfinite(resolution_m) || resolution_m <= 0.0) {
-    throw std::invalid_argument("inflation: resolution must be positive, got " +
-                                std::to_string(resolution_m));
-  }
+  const std::string why = config.validate(resolution_m);
+  if (!why.empty()) throw std::invalid_argument("inflation: " + why);
   config_ = config;
   resolution_ = resolution_m;
   const double radius = config.inflation_radius / resolution_m;  // cells
@@ -171,14 +182,16 @@ void Inflator::shift(int dx, int dy) {
   }
   const int nx = geometry_.sizeX();
   const int ny = geometry_.sizeY();
-  if (std::abs(dx) >= nx || std::abs(dy) >= ny) {
+  // 64-bit: std::abs(INT_MIN) is undefined.
+  if (std::abs(std::int64_t{dx}) >= nx || std::abs(std::int64_t{dy}) >= ny) {
     geometry_ = shiftedGeometry(geometry_, dx, dy);
     full_recompute_ = true;
     return;
   }
+  const GridGeometry shifted = shiftedGeometry(geometry_, dx, dy);  // may throw: nothing moved
   shiftGridData(&lethal_, nx, ny, dx, dy, std::uint8_t{0});
   shiftGridData(&costs_, nx, ny, dx, dy, std::uint8_t{0});
-  geometry_ = shiftedGeometry(geometry_, dx, dy);
+  geometry_ = shifted;
   // Bands still pending from an earlier shift move with the content.
   std::vector<CellBounds> moved;
   for (const CellBounds& b : pending_regions_) {

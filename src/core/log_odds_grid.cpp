@@ -142,8 +142,10 @@ CellBounds LogOddsGrid::decay(double factor, const CellBounds& window, std::size
 }
 
 void LogOddsGrid::shift(int dx, int dy) {
+  // The new geometry first: if its origin is not finite it throws and nothing has moved.
+  const GridGeometry shifted = shiftedGeometry(geometry_, dx, dy);
   shiftGridData(&cells_, geometry_.sizeX(), geometry_.sizeY(), dx, dy, std::int16_t{0});
-  geometry_ = shiftedGeometry(geometry_, dx, dy);
+  geometry_ = shifted;
 }
 
 }  // namespace downstream_perception

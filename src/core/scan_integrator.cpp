@@ -142,14 +142,14 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
 
 std::string ScanIntegratorConfig::validate() const {
   std::ostringstream why;
-  const auto ok = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  const auto ok = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= kMaxRangeM; };
   if (!ok(obstacle_min_range) || !ok(obstacle_max_range) ||
       obstacle_min_range > obstacle_max_range) {
-    why << "need 0 <= obstacle_min_range <= obstacle_max_range (finite, m), got ["
+    why << "need 0 <= obstacle_min_range <= obstacle_max_range <= " << kMaxRangeM << " m, got ["
         << obstacle_min_range << ", " << obstacle_max_range << "]";
   } else if (!ok(raytrace_min_range) || !ok(raytrace_max_range) ||
              raytrace_min_range > raytrace_max_range) {
-    why << "need 0 <= raytrace_min_range <= raytrace_max_range (finite, m), got ["
+    why << "need 0 <= raytrace_min_range <= raytrace_max_range <= " << kMaxRangeM << " m, got ["
         << raytrace_min_range << ", " << raytrace_max_range << "]";
   }
   return why.str();

@@ -33,15 +33,24 @@ void InflationLayer::reconfigure(InflationLayerConfig& cfg, std::uint32_t) {
 void InflationLayer::applyConfig(InflationConfig candidate) {
   std::lock_guard<std::mutex> lock(mutex_);
   candidate.inscribed_radius = layered_costmap_->inscribedRadius();
-  const std::string why = candidate.validate();
+  const double map_resolution = layered_costmap_->costmap().geometry().resolution();
+  const double resolution = map_resolution > 0.0 ? map_resolution : 0.05;
+  const std::string why = candidate.validate(resolution);
   if (!why.empty()) {
-    const std::string msg = "parameters invalid (" + why + "); keeping inflation_radius " +
-                            std::to_string(config_.inflation_radius) + " m, cost_scaling_factor " +
-                            std::to_string(config_.cost_scaling_factor) + " 1/m";
-    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-    config_errors_.push_back(msg);
+    std::string msg = "parameters invalid (" + why + "); keeping inflation_radius " +
+                      std::to_string(config_.inflation_radius) + " m, cost_scaling_factor " +
+                      std::to_string(config_.cost_scaling_factor) + " 1/m";
     candidate = config_;
     candidate.inscribed_radius = layered_costmap_->inscribedRadius();
+    if (!candidate.validate(resolution).empty()) {
+      // The kept radius does not fit this resolution either (the costmap became finer): the
+      // largest radius that does, rather than no inflation at all.
+      candidate.inflation_radius = InflationConfig::kMaxRadiusCells * resolution;
+      msg += " capped to " + std::to_string(candidate.inflation_radius) + " m (" +
+             std::to_string(InflationConfig::kMaxRadiusCells) + " cells)";
+    }
+    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
+    config_errors_.push_back(msg);
   }
   if (candidate.inflation_radius < candidate.inscribed_radius) {
     // Allowed (costmap_2d accepts it) but the robot would touch walls the planner thinks clear.
@@ -51,8 +60,7 @@ void InflationLayer::applyConfig(InflationConfig candidate) {
         name_.c_str(), candidate.inflation_radius, candidate.inscribed_radius);
   }
   config_ = candidate;
-  const double resolution = layered_costmap_->costmap().geometry().resolution();
-  inflator_ = std::make_unique<Inflator>(config_, resolution > 0.0 ? resolution : 0.05);
+  inflator_ = std::make_unique<Inflator>(config_, resolution);
   need_full_window_ = true;
   ROS_INFO(
       "layer '%s': inflation radius %.3f m (%d cells), cost_scaling_factor %.2f 1/m, "

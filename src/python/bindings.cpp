@@ -381,7 +381,11 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor, "1/m")
       .def_readwrite("inscribed_radius", &InflationConfig::inscribed_radius, "m")
       .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown)
-      .def("validate", &InflationConfig::validate);
+      .def_readonly_static("MAX_RADIUS_CELLS", &InflationConfig::kMaxRadiusCells,
+                           "largest inflation_radius / resolution accepted")
+      .def("validate", py::overload_cast<>(&InflationConfig::validate, py::const_))
+      .def("validate", py::overload_cast<double>(&InflationConfig::validate, py::const_),
+           py::arg("resolution_m"), "Also checks the radius in cells at this resolution.");
   m.def("inflation_cost", &inflationCost, py::arg("distance_m"), py::arg("config"),
         "costmap_2d's cost for a cell at distance_m from the nearest lethal cell.");
   m.def(
@@ -570,6 +574,8 @@ PYBIND11_MODULE(_core, m) {
       "predicted_cells",
       [](const PlanarTrack& track, double age_s, const PredictionConfig& config,
          const GridGeometry& geometry) {
+        const std::string why = validatePrediction(track, age_s, config);
+        if (!why.empty()) throw std::invalid_argument(why);
         std::vector<std::size_t> cells;
         predictedCells(track, age_s, config, geometry, &cells);
         std::vector<CellIndex> xy;
@@ -578,11 +584,15 @@ PYBIND11_MODULE(_core, m) {
         return cellsToArray(xy);
       },
       py::arg("track"), py::arg("age_s"), py::arg("config"), py::arg("geometry"),
-      "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s.");
+      "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s. "
+      "Raises ValueError if the track, age_s or the config is invalid.");
   m.def(
       "recent_cells",
       [](const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
          double max_object_size_m, const GridGeometry& geometry) {
+        const std::string why =
+            recentCellsReason(track, lookback_s, age_s, margin_m, max_object_size_m);
+        if (!why.empty()) throw std::invalid_argument(why);
         std::vector<std::size_t> cells;
         recentCells(track, lookback_s, age_s, margin_m, max_object_size_m, geometry, &cells);
         std::vector<CellIndex> xy;
@@ -611,6 +621,10 @@ PYBIND11_MODULE(_core, m) {
       .value("METRIC", TrackerConfig::Mode::kMetric)
       .value("IMAGE", TrackerConfig::Mode::kImage);
   tc.def(py::init<>())
+      .def_readonly_static("MAX_BOX_COORDINATE_PX", &TrackerConfig::kMaxBoxCoordinatePx,
+                           "image mode: larger |box coordinates| are rejected (out of range)")
+      .def_readonly_static("MAX_POSITION_M", &TrackerConfig::kMaxPositionM,
+                           "metric mode: larger |position| / size are rejected (out of range)")
       .def_readwrite("mode", &TrackerConfig::mode)
       .def_readwrite("gate_confidence", &TrackerConfig::gate_confidence)
       .def_readwrite("duplicate_confidence", &TrackerConfig::duplicate_confidence)
@@ -630,6 +644,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("detections", &TrackerStats::detections)
       .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score)
       .def_readonly("detections_rejected_invalid", &TrackerStats::detections_rejected_invalid)
+      .def_readonly("detections_rejected_out_of_range",
+                    &TrackerStats::detections_rejected_out_of_range)
       .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass)
       .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass)
       .def_readonly("births", &TrackerStats::births)

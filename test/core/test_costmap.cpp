@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <stdexcept>
+
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/core/costmap.h"
 
@@ -40,4 +43,27 @@ TEST(Costmap, ResetWindowAndShift) {
   EXPECT_EQ(m.cost(4, 1), 33);                    // old (3, 3)
   EXPECT_EQ(m.cost(0, 0), cost::kNoInformation);  // newly exposed column
   EXPECT_EQ(m.cost(2, 3), cost::kNoInformation);  // newly exposed rows
+}
+
+// Issue 17 item 8: size + shift overflowed an int for a shift of 2^31 - 1 (undefined behaviour;
+// UBSan reports it). Any shift of at least the grid's size drops everything.
+TEST(Costmap, ExtremeShiftsDropEverythingWithoutOverflow) {
+  const int int_max = std::numeric_limits<int>::max();
+  const int int_min = std::numeric_limits<int>::min();
+  for (const int d : {int_max, int_min, -int_max, int_max - 4, int_min + 4, 1 << 30, 5, -5}) {
+    for (const bool along_x : {true, false}) {
+      Costmap m(GridGeometry(5, 4, 0.5, 0.0, 0.0), cost::kNoInformation);
+      for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 5; ++x) m.setCost(x, y, cost::kLethalObstacle);
+      m.shift(along_x ? d : 0, along_x ? 0 : d);
+      for (const std::uint8_t c : m.cells()) ASSERT_EQ(c, cost::kNoInformation) << d;
+      EXPECT_DOUBLE_EQ(along_x ? m.geometry().originX() : m.geometry().originY(), 0.5 * d);
+    }
+  }
+  // A new origin that is not finite is refused and nothing moves.
+  Costmap huge(GridGeometry(3, 3, 1e300, 0.0, 0.0), cost::kFreeSpace);
+  huge.setCost(1, 1, cost::kLethalObstacle);
+  EXPECT_THROW(huge.shift(int_max, 0), std::invalid_argument);
+  EXPECT_EQ(huge.cost(1, 1), cost::kLethalObstacle);
+  EXPECT_EQ(huge.geometry().originX(), 0.0);
 }

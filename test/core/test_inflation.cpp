@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "downstream_perception/core/inflation.h"
 
@@ -243,6 +246,34 @@ TEST(Inflator, RejectsAbsurdConfigs) {
   EXPECT_TRUE(InflationConfig{}.validate().empty());
 }
 
+// Issue 17 item 8: 0.55 m at 2e-5 m (27,500 cells) took 28 s per update; at 5e-324 m the cost
+// table could not be allocated ("cannot create std::vector larger than max_size()").
+TEST(Inflator, RefusesRadiiOfTooManyCells) {
+  InflationConfig c;  // 0.55 m
+  for (const double res : {2e-5, 5e-324, 1e-200}) {
+    const std::string why = c.validate(res);
+    EXPECT_NE(why.find("cells"), std::string::npos) << res << ": " << why;
+    EXPECT_THROW(Inflator(c, res), std::invalid_argument) << res;
+  }
+  for (const double res : {0.0, -0.05, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    EXPECT_NE(c.validate(res).find("resolution"), std::string::npos) << res;
+    EXPECT_THROW(Inflator(c, res), std::invalid_argument) << res;
+  }
+  // The bound itself is accepted, one cell more is not.
+  c.inflation_radius = InflationConfig::kMaxRadiusCells * 0.05;
+  EXPECT_EQ(c.validate(0.05), "");
+  Inflator at_limit(c, 0.05);
+  EXPECT_EQ(at_limit.radiusCells(), InflationConfig::kMaxRadiusCells);
+  c.inflation_radius = (InflationConfig::kMaxRadiusCells + 1) * 0.01;
+  EXPECT_FALSE(c.validate(0.01).empty());
+  // A radius of 0 fits any resolution; a refused setConfig keeps the old config.
+  c.inflation_radius = 0.0;
+  EXPECT_EQ(c.validate(5e-324), "");
+  Inflator kept(InflationConfig{}, 0.05);
+  EXPECT_THROW(kept.setConfig(InflationConfig{}, 2e-5), std::invalid_argument);
+  EXPECT_EQ(kept.radiusCells(), 11);
+}
+
 TEST(Inflator, RollingWindowShiftsEqualFullRecomputation) {
   // A robot-centred window moving over a fixed random world: after each whole-cell shift (and
   // the lethal cells that came into view), the shifted cache must equal a fresh inflation of the
@@ -308,4 +339,28 @@ TEST(Inflator, SmallShiftRecomputesOnlyTheEdges) {
   const InflationStats stats = inflator.update(&master, everything(master.geometry()));
   // The exposed column and the band of radius + 1 columns at the other edge: 8 of 400 columns.
   EXPECT_EQ(stats.cells_recomputed, 8u * 400u);
+}
+
+// Issue 17 item 8: std::abs(INT_MIN) in Inflator::shift is undefined (UBSan); any shift of at
+// least the grid's size must simply recompute everything.
+TEST(Inflator, ExtremeShiftsEqualFullRecomputation) {
+  std::mt19937 rng(37);
+  const GridGeometry g(60, 50, 0.05, 0.0, 0.0);
+  InflationConfig c;
+  c.inflation_radius = 0.3;
+  for (const int d : {std::numeric_limits<int>::min(), std::numeric_limits<int>::max(), -60, 50}) {
+    Costmap master = randomLethalMap(g, 0.01, rng);
+    Inflator inflator(c, g.resolution());
+    inflator.update(&master, everything(g));
+    master.shift(d, 1);
+    inflator.shift(d, 1);
+    const GridGeometry moved = master.geometry();
+    Costmap fresh = randomLethalMap(moved, 0.01, rng);
+    master = fresh;
+    inflator.update(&master, everything(moved));
+    Inflator full(c, moved.resolution());
+    full.update(&fresh, everything(moved));
+    ASSERT_EQ(inflator.costs(), full.costs()) << "shift " << d;
+    ASSERT_EQ(master.cells(), fresh.cells()) << "shift " << d;
+  }
 }

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/core/costmap.h"
@@ -247,4 +250,60 @@ TEST(PredictedFootprint, RecentCellsClampAbsurdSizesAndRefuseBadArguments) {
   t.velocity.x() = std::numeric_limits<double>::infinity();
   EXPECT_TRUE(recentCells(t, 0.0, 0.0, 0.0, 1.0, g, &cells).empty());
   EXPECT_TRUE(cells.empty());
+}
+
+// Issue 17 item 8: the helpers skipped validate(): a NaN polygon and a negative radius came out,
+// and an invalid config (min_object_size_m > max_object_size_m: std::clamp is undefined then)
+// was swept.
+TEST(PredictedFootprint, HelpersValidateTheirInputs) {
+  const GridGeometry g(100, 100, 0.05, 0.0, 0.0);
+  PlanarTrack t;
+  t.position = {2.0, 2.0};
+  t.velocity = {0.5, 0.0};
+  t.size_x = 0.4;
+  t.size_y = 0.3;
+  const PredictionConfig ok;
+  EXPECT_EQ(validatePrediction(t, 1.0, ok), "");
+
+  PlanarTrack nan_size = t;
+  nan_size.size_x = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validatePrediction(nan_size, 1.0, ok).find("track"), std::string::npos);
+  EXPECT_THROW(sweptPolygon(nan_size, 1.0, ok), std::invalid_argument);
+  EXPECT_THROW(uncertaintyRadius(nan_size, 1.0, ok), std::invalid_argument);
+
+  PredictionConfig negative_cap;
+  negative_cap.max_uncertainty_m = -1.0;
+  EXPECT_NE(validatePrediction(t, 1.0, negative_cap).find("max_uncertainty_m"), std::string::npos);
+  EXPECT_THROW(uncertaintyRadius(t, 1.0, negative_cap), std::invalid_argument);
+  PredictionConfig reversed;
+  reversed.min_object_size_m = 2.0;
+  reversed.max_object_size_m = 1.0;
+  EXPECT_THROW(sweptPolygon(t, 1.0, reversed), std::invalid_argument);
+  EXPECT_THROW(sweptPolygon(t, std::numeric_limits<double>::infinity(), ok), std::invalid_argument);
+
+  // predictedCells does not throw (it runs per track on message data): it appends nothing.
+  std::vector<std::size_t> cells;
+  EXPECT_TRUE(predictedCells(t, 0.0, negative_cap, g, &cells).empty());
+  EXPECT_TRUE(predictedCells(t, 0.0, reversed, g, &cells).empty());
+  EXPECT_TRUE(cells.empty());
+  EXPECT_FALSE(predictedCells(t, 0.0, ok, g, &cells).empty());  // the same track, valid config
+
+  // Valid inputs give finite shapes; recentCellsReason names what recentCells refuses.
+  for (const FootprintPoint& p : sweptPolygon(t, 1.0, ok)) {
+    EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y));
+  }
+  EXPECT_EQ(recentCellsReason(t, 0.1, 0.1, 0.1, 5.0), "");
+  EXPECT_NE(recentCellsReason(t, -0.1, 0.1, 0.1, 5.0).find("lookback_s"), std::string::npos);
+  EXPECT_NE(recentCellsReason(nan_size, 0.1, 0.1, 0.1, 5.0).find("track"), std::string::npos);
+}
+
+TEST(PredictedFootprint, OverflowingUncertaintyIsCappedNotZero) {
+  // dt^2 * Σv overflows to inf and inf * 0 (the off-diagonal) is NaN: the growth is beyond any
+  // cap, so it is the cap (the eigenvalue formula's NaN used to come out as 0).
+  PlanarTrack t;
+  t.velocity_covariance << 1.0, 0.0, 0.0, 1.0;
+  PredictionConfig c;
+  c.max_uncertainty_m = 0.7;
+  EXPECT_DOUBLE_EQ(uncertaintyRadius(t, 1e200, c), 0.7);
+  EXPECT_DOUBLE_EQ(uncertaintyRadius(t, 0.1, c), 2.0 * 0.1);  // k sqrt(dt^2 * 1), below the cap
 }

@@ -3,6 +3,9 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/scan_integrator.h"
@@ -294,4 +297,63 @@ TEST(MovingScan, PerBeamPosesPutAWallWhereItIs) {
   std::vector<BeamUpdate> same;
   integrator.beamsFromMovingScan(view, first, first, &same, &stats);
   for (std::size_t k = 0; k < n; ++k) EXPECT_NEAR(same[k].hit_x, rigid[k].hit_x, 1e-9);
+}
+
+// Issue 17 item 4: a beam from a sensor 1e18 m away (a tf gone wrong) was clipped to a start
+// cell outside the grid and the pointer walk read and wrote past the cell array.
+TEST(ScanIntegrator, FarAwaySensorNeverWalksOutOfTheGrid) {
+  const GridGeometry geometry(200, 200, 0.05, -5.0, -5.0);
+  LogOddsGrid grid(geometry);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (const double far : {1e12, 1e15, 1e18, 1e300}) {
+    std::vector<BeamUpdate> beams;
+    for (int n = 0; n < 2000; ++n) {
+      BeamUpdate b;
+      const double a = M_PI * unit(rng);
+      b.start_x = far * std::cos(a);
+      b.start_y = far * std::sin(a);
+      b.end_x = 4.9 * unit(rng);
+      b.end_y = 4.9 * unit(rng);
+      b.clear = true;
+      b.clear_end_cell = n % 2 == 0;
+      b.mark = n % 3 == 0;
+      b.hit_x = b.end_x;
+      b.hit_y = b.end_y;
+      beams.push_back(b);
+      std::swap(b.start_x, b.end_x);  // and the beam the other way, ending far away
+      std::swap(b.start_y, b.end_y);
+      b.mark = false;
+      beams.push_back(b);
+    }
+    const IntegrationStats stats = integrateBeams(grid, beams);
+    ASSERT_FALSE(stats.touched.empty());
+    EXPECT_GE(stats.touched.min_x, 0) << far;
+    EXPECT_GE(stats.touched.min_y, 0) << far;
+    EXPECT_LT(stats.touched.max_x, geometry.sizeX()) << far;
+    EXPECT_LT(stats.touched.max_y, geometry.sizeY()) << far;
+    EXPECT_GT(stats.cells_cleared, 2000u);
+  }
+  for (std::size_t i = 0; i < geometry.cellCount(); ++i) ASSERT_FALSE(grid.flagged(i));
+}
+
+TEST(ScanIntegratorConfig, RangesAreBounded) {
+  ScanIntegratorConfig ok;
+  ok.obstacle_max_range = ScanIntegratorConfig::kMaxRangeM;
+  ok.raytrace_max_range = ScanIntegratorConfig::kMaxRangeM;
+  EXPECT_EQ(ok.validate(), "");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double bad : {1e15, 1.0001e4, std::numeric_limits<double>::infinity(), nan, -0.5}) {
+    ScanIntegratorConfig c;
+    c.raytrace_max_range = bad;
+    EXPECT_NE(c.validate().find("raytrace_max_range"), std::string::npos) << bad;
+    c = ScanIntegratorConfig{};
+    c.obstacle_max_range = bad;
+    EXPECT_NE(c.validate().find("obstacle_max_range"), std::string::npos) << bad;
+    EXPECT_THROW(ScanIntegrator{c}, std::invalid_argument);
+  }
+  ScanIntegratorConfig reversed;
+  reversed.raytrace_min_range = 5.0;
+  reversed.raytrace_max_range = 4.0;
+  EXPECT_FALSE(reversed.validate().empty());
 }

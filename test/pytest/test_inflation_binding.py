@@ -61,3 +61,24 @@ def test_lesson_golden_costs_and_footprint() -> None:
     bad.inflation_radius = -1.0
     with pytest.raises(ValueError):
         dp.inflate(np.zeros((3, 3), np.uint8), 0.05, bad)
+
+
+@pytest.mark.parametrize("resolution", [2e-5, 5e-324])
+def test_radius_of_too_many_cells_is_refused(resolution: float) -> None:
+    # Issue 17 item 8: 0.55 m at 2e-5 m took 28 s per update; at 5e-324 m the cost table could not
+    # be allocated. Both are refused with the bound in the message.
+    config = dp.InflationConfig()
+    costs = np.zeros((4, 4), np.uint8)
+    costs[1, 1] = dp.LETHAL_OBSTACLE
+    with pytest.raises(ValueError, match="cells"):
+        dp.inflate(costs, resolution, config)
+    assert "cells" in config.validate(resolution)
+
+
+def test_radius_at_the_cell_limit_is_accepted() -> None:
+    config = dp.InflationConfig()
+    config.inflation_radius = dp.InflationConfig.MAX_RADIUS_CELLS * 0.05
+    assert config.validate(0.05) == ""
+    costs = np.zeros((3, 3), np.uint8)
+    costs[1, 1] = dp.LETHAL_OBSTACLE
+    assert dp.inflate(costs, 0.05, config)[0, 0] > 0

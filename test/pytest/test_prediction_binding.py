@@ -81,13 +81,14 @@ def test_swept_box_with_uncertainty_matches_numpy() -> None:
     assert len(got) > 100
 
 
-def test_bad_tracks_give_no_cells() -> None:
+def test_bad_tracks_are_refused_and_fast_ones_give_no_cells() -> None:
     grid = dp.GridGeometry(100, 100, 0.05, 0.0, 0.0)
     config = dp.PredictionConfig()
     nan_track = dp.PlanarTrack([math.nan, 1.0], [0.0, 0.0])
     assert nan_track.validate() != ""
-    assert dp.predicted_cells(nan_track, 0.0, config, grid).shape == (0, 2)
-    fast = dp.PlanarTrack([1.0, 1.0], [100.0, 0.0])  # beyond max_speed_mps
+    with pytest.raises(ValueError, match="position is not finite"):
+        dp.predicted_cells(nan_track, 0.0, config, grid)
+    fast = dp.PlanarTrack([1.0, 1.0], [100.0, 0.0])  # beyond max_speed_mps: valid, not swept
     assert dp.predicted_cells(fast, 0.0, config, grid).shape == (0, 2)
     config.prediction_horizon_s = -1.0
     assert "prediction_horizon_s" in config.validate()
@@ -111,7 +112,8 @@ def test_recent_cells_cover_where_the_object_was_not_where_it_goes() -> None:
     # Nothing beyond where the object is now (the prediction's business, not the clearing's).
     front = 4.0 + 0.5 * age + c * hx + s * hy
     assert max(x for x, _ in cells) * 0.05 <= front
-    assert dp.recent_cells(track, -1.0, age, margin, 5.0, grid).shape == (0, 2)
+    with pytest.raises(ValueError, match="lookback_s"):
+        dp.recent_cells(track, -1.0, age, margin, 5.0, grid)
 
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
@@ -132,3 +134,35 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
 
     lower, upper = half(pts), half(pts[::-1])
     return np.array(lower[:-1] + upper[:-1])
+
+
+def test_invalid_inputs_raise_value_error_with_the_reason() -> None:
+    # Issue 17 item 8: the helpers skipped validate(): a NaN polygon and a negative radius came out.
+    grid = dp.GridGeometry(40, 40, 0.1, 0.0, 0.0)
+    good = dp.PlanarTrack([2.0, 2.0], [0.5, 0.0], size_x=0.5, size_y=0.4)
+    nan_size = dp.PlanarTrack([2.0, 2.0], [0.5, 0.0], size_x=math.nan, size_y=0.4)
+    negative_cap = dp.PredictionConfig()
+    negative_cap.max_uncertainty_m = -1.0
+    reversed_sizes = dp.PredictionConfig()
+    reversed_sizes.min_object_size_m = 2.0
+    reversed_sizes.max_object_size_m = 1.0
+    with pytest.raises(ValueError, match="size or orientation"):
+        dp.swept_polygon(nan_size, 1.0, dp.PredictionConfig())
+    with pytest.raises(ValueError, match="min_object_size_m"):
+        dp.swept_polygon(good, 1.0, reversed_sizes)
+    with pytest.raises(ValueError, match="max_uncertainty_m"):
+        dp.uncertainty_radius(good, 1.0, negative_cap)
+    with pytest.raises(ValueError, match="time"):
+        dp.swept_polygon(good, math.inf, dp.PredictionConfig())
+    with pytest.raises(ValueError, match="max_uncertainty_m"):
+        dp.predicted_cells(good, 0.0, negative_cap, grid)
+    with pytest.raises(ValueError, match="size or orientation"):
+        dp.predicted_cells(nan_size, 0.0, dp.PredictionConfig(), grid)
+    with pytest.raises(ValueError, match="lookback_s"):
+        dp.recent_cells(good, -1.0, 0.0, 0.1, 5.0, grid)
+    with pytest.raises(ValueError, match="size or orientation"):
+        dp.recent_cells(nan_size, 0.1, 0.0, 0.1, 5.0, grid)
+    # Valid inputs still give finite results.
+    assert np.isfinite(dp.swept_polygon(good, 1.0, dp.PredictionConfig())).all()
+    assert dp.uncertainty_radius(good, 1.0, dp.PredictionConfig()) >= 0.0
+    assert len(dp.predicted_cells(good, 0.0, dp.PredictionConfig(), grid)) > 0

@@ -103,3 +103,26 @@ def test_tracker_rejects_bad_shapes_and_counts_bad_values() -> None:
     config.min_hits = 0
     with pytest.raises(ValueError):
         dp.Tracker(config)
+
+
+def test_tracker_counts_out_of_range_and_negative_detections() -> None:
+    # Issue 17 item 8: an image box at 1e308 px made the covariance infinite; negative sizes and
+    # positions of 1e30 m were accepted silently.
+    config = dp.TrackerConfig()
+    config.mode = dp.TrackerConfig.Mode.IMAGE
+    tracker = dp.Tracker(config)
+    boxes = np.array([[0.0, 0.0, 1e308, 1e308], [10.0, 10.0, 60.0, 90.0]])
+    for k in range(4):
+        stats = tracker.step(0.1 * k, boxes)
+        assert stats.detections_rejected_out_of_range == 1
+        assert stats.detections_rejected_invalid == 0
+    tracks = tracker.tracks()
+    assert len(tracks["id"]) == 1
+    assert np.isfinite(tracks["position_cov"]).all() and np.isfinite(tracks["velocity_cov"]).all()
+    assert dp.TrackerConfig.MAX_BOX_COORDINATE_PX == 1e6
+
+    metric = dp.Tracker()
+    too_far = -2.0 * dp.TrackerConfig.MAX_POSITION_M
+    stats = metric.step(0.0, np.array([[1e30, 0.0], [1.0, 2.0], [too_far, 0.0]]))
+    assert stats.detections_rejected_out_of_range == 2
+    assert len(metric.tracks()["id"]) == 1

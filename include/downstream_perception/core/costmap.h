@@ -26,7 +26,8 @@ class Costmap {
   /// Cells of the inclusive window to the default value (clamped to the grid).
   void resetWindow(const CellBounds& window);
   /// Moves the origin by whole cells (rolling window): content that stays in view keeps its world
-  /// position, newly exposed cells get the default value.
+  /// position, newly exposed cells get the default value. Any dx, dy; throws
+  /// std::invalid_argument (and changes nothing) if the new origin would not be finite.
   void shift(int dx, int dy);
 
   std::uint8_t cost(int x, int y) const { return cells_[geometry_.index(x, y)]; }

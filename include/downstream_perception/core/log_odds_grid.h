@@ -115,6 +115,8 @@ class LogOddsGrid {
   CellBounds decay(double factor, const CellBounds& window, std::size_t* changed_cells = nullptr);
   /// Shifts the content so that cell (dx, dy) of the old grid becomes cell (0, 0); cells that come
   /// into view are unknown, cells that leave are dropped. The origin moves by (dx, dy) cells.
+  /// Any dx, dy; throws std::invalid_argument (and changes nothing) if the new origin would not
+  /// be finite.
   void shift(int dx, int dy);
 
  private:

@@ -12,6 +12,7 @@
 //    in x first (the two side cells are touched only at a point, so either choice is exact).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -23,19 +24,21 @@
 namespace downstream_perception {
 
 /// Visits (x, y) for every cell of the Bresenham line from (x0, y0) to (x1, y1), both included.
+/// Any ints: the deltas and the error term are 64-bit (x1 - x0 of two extreme ints does not fit
+/// in an int), and x, y only move toward x1, y1, so they never leave the ints' range.
 template <class Visitor>
 void bresenham(int x0, int y0, int x1, int y1, Visitor&& visit) {
-  const int dx = std::abs(x1 - x0);
-  const int dy = std::abs(y1 - y0);
+  const std::int64_t dx = std::abs(std::int64_t{x1} - x0);
+  const std::int64_t dy = std::abs(std::int64_t{y1} - y0);
   const int sx = x0 < x1 ? 1 : -1;
   const int sy = y0 < y1 ? 1 : -1;
-  int err = dx - dy;
+  std::int64_t err = dx - dy;
   int x = x0;
   int y = y0;
   while (true) {
     visit(x, y);
     if (x == x1 && y == y1) return;
-    const int e2 = 2 * err;
+    const std::int64_t e2 = 2 * err;
     if (e2 > -dy) {
       err -= dy;
       x += sx;
@@ -47,10 +50,16 @@ void bresenham(int x0, int y0, int x1, int y1, Visitor&& visit) {
   }
 }
 
+/// The cells of bresenham() as a vector. Throws std::invalid_argument for a line of more than
+/// GridGeometry::kMaxCellsPerAxis cells (longer than any grid's axis: a typo, and gigabytes).
 std::vector<CellIndex> bresenhamLine(int x0, int y0, int x1, int y1);
 
 /// Clips the world segment (x0,y0)-(x1,y1) to the grid's extent (Liang-Barsky). Returns false if
-/// it misses the grid. *start_clipped / *end_clipped tell whether an end was moved.
+/// it misses the grid or is not finite. *start_clipped / *end_clipped tell whether an end was
+/// moved. A moved end is put exactly on the grid edge it was moved to and its other coordinate
+/// clamped into the grid's box, so no input (an end 1e18 m away, where the clip's rounding is
+/// ~100 m) can put it outside; along the edge it then lies where the rounding put it, which for
+/// such an input is as good as any point.
 bool clipSegmentToGrid(const GridGeometry& grid, double* x0, double* y0, double* x1, double* y1,
                        bool* start_clipped = nullptr, bool* end_clipped = nullptr);
 
@@ -81,17 +90,26 @@ struct RayWalk {
   std::int64_t err_step_x = 0;  ///< added to err on an x step
   std::int64_t err_step_y = 0;  ///< subtracted from err on a y step
 
-  /// The segment (x0,y0)-(x1,y1) must lie inside the grid (clip it first).
+  /// The segment (x0,y0)-(x1,y1) should lie inside the grid (clip it first). Whatever it is, the
+  /// fixed-point ends are clamped into the grid (NaN to 0), so the walk never leaves the grid:
+  /// rounding can still put a clipped end a hair outside when the origin is huge (at 1e17 m a
+  /// double's step is 16 m, more than the grid's eps margin). Inside the grid the clamp changes
+  /// nothing. The grid's per-axis limit (2^22 cells) bounds the coordinates by 2^42 and every
+  /// product below by 2^62, so the int64 arithmetic cannot overflow.
   RayWalk(const GridGeometry& grid, double x0, double y0, double x1, double y1) {
     const double scale = static_cast<double>(kOne) / grid.resolution();
-    // Round to nearest; the (clipped, in-grid) coordinates are non-negative, so truncating
-    // v + 0.5 is the rounding (and avoids a libm call per coordinate).
-    const auto fixed = [scale](double v) { return static_cast<std::int64_t>(v * scale + 0.5); };
-    const std::int64_t fx0 = fixed(x0 - grid.originX());
-    const std::int64_t fy0 = fixed(y0 - grid.originY());
-    const std::int64_t fx1 = fixed(x1 - grid.originX());
-    const std::int64_t fy1 = fixed(y1 - grid.originY());
-    // Arithmetic shift = floor division for the (in-grid, non-negative) coordinates.
+    // Round to nearest; the clamped coordinates are non-negative, so truncating v + 0.5 is the
+    // rounding (and avoids a libm call per coordinate). Clamped as doubles: casting an
+    // out-of-range double to int64 is undefined.
+    const auto fixed = [scale](double v, int cells) {
+      const double hi = static_cast<double>(std::max<std::int64_t>(0, cells * kOne - 1));
+      return static_cast<std::int64_t>(std::max(0.0, std::min(v * scale + 0.5, hi)));
+    };
+    const std::int64_t fx0 = fixed(x0 - grid.originX(), grid.sizeX());
+    const std::int64_t fy0 = fixed(y0 - grid.originY(), grid.sizeY());
+    const std::int64_t fx1 = fixed(x1 - grid.originX(), grid.sizeX());
+    const std::int64_t fy1 = fixed(y1 - grid.originY(), grid.sizeY());
+    // Arithmetic shift = floor division for the (clamped, non-negative) coordinates.
     cx = static_cast<int>(fx0 >> kShift);
     cy = static_cast<int>(fy0 >> kShift);
     const int ex = static_cast<int>(fx1 >> kShift);

@@ -77,6 +77,10 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                                 std::vector<std::uint32_t>* scratch = nullptr);
 
 struct ScanIntegratorConfig {
+  /// Largest accepted obstacle / raytrace range (m): 10 km, beyond any range sensor. A larger
+  /// value is a typo, and ranges of ~1e15 m put beam ends where a double cannot place them.
+  static constexpr double kMaxRangeM = 1e4;
+
   bool marking = true;
   bool clearing = true;
   double obstacle_min_range = 0.0;      ///< m: returns nearer than this do not mark
@@ -86,6 +90,8 @@ struct ScanIntegratorConfig {
   bool inf_is_valid = true;             ///< +Inf means "no return": clear, do not mark
   bool range_max_is_no_return = false;  ///< treat r == range_max as +Inf
 
+  /// Empty if 0 <= obstacle_min_range <= obstacle_max_range <= kMaxRangeM and the same for the
+  /// raytrace ranges (all finite), else the reason.
   std::string validate() const;
 };
 

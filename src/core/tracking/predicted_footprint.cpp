@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "downstream_perception/core/ray_traversal.h"
 
@@ -46,21 +48,43 @@ std::string PlanarTrack::validate() const {
   return {};
 }
 
+std::string validatePrediction(const PlanarTrack& track, double time_s,
+                               const PredictionConfig& config) {
+  std::string why = track.validate();
+  if (!why.empty()) return "track: " + why;
+  why = config.validate();
+  if (!why.empty()) return "config: " + why;
+  if (!(std::isfinite(time_s) && time_s >= 0.0)) {
+    return "time must be finite and >= 0 s, got " + std::to_string(time_s);
+  }
+  return {};
+}
+
 Eigen::Vector2d predictPosition(const PlanarTrack& track, double dt_s) {
   return track.position + track.velocity * dt_s;
 }
 
-double uncertaintyRadius(const PlanarTrack& track, double dt_s, const PredictionConfig& config) {
+namespace {
+
+void throwIfInvalid(const PlanarTrack& track, double time_s, const PredictionConfig& config) {
+  const std::string why = validatePrediction(track, time_s, config);
+  if (!why.empty()) throw std::invalid_argument(why);
+}
+
+// The unchecked helpers: every public function validates first (the config recentCells builds
+// for itself has no speed limit, which validate() would refuse).
+double radiusOf(const PlanarTrack& track, double dt_s, const PredictionConfig& config) {
   if (config.uncertainty_sigmas <= 0.0) return 0.0;
   const Eigen::Matrix2d sigma = track.position_covariance + dt_s * dt_s * track.velocity_covariance;
   // Largest eigenvalue of a symmetric 2 x 2, in closed form.
   const double mean = 0.5 * (sigma(0, 0) + sigma(1, 1));
   const double half_gap = 0.5 * (sigma(0, 0) - sigma(1, 1));
-  const double largest = std::max(0.0, mean + std::hypot(half_gap, sigma(0, 1)));
+  const double eigen = mean + std::hypot(half_gap, sigma(0, 1));
+  // NaN only when dt^2 * Σv overflowed (inf * 0, inf - inf): an uncertainty beyond any cap.
+  if (std::isnan(eigen)) return config.max_uncertainty_m;
+  const double largest = std::max(0.0, eigen);
   return std::min(config.max_uncertainty_m, config.uncertainty_sigmas * std::sqrt(largest));
 }
-
-namespace {
 
 double cross(const FootprintPoint& o, const FootprintPoint& a, const FootprintPoint& b) {
   return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -111,10 +135,7 @@ double convexDistance(double px, double py, const Footprint& hull) {
   return inside ? 0.0 : nearest;
 }
 
-}  // namespace
-
-Footprint sweptPolygon(const PlanarTrack& track, double duration_s,
-                       const PredictionConfig& config) {
+Footprint sweptHull(const PlanarTrack& track, double duration_s, const PredictionConfig& config) {
   const double hx =
       0.5 * std::clamp(track.size_x, config.min_object_size_m, config.max_object_size_m);
   const double hy =
@@ -132,14 +153,14 @@ Footprint sweptPolygon(const PlanarTrack& track, double duration_s,
   return convexHull(std::move(corners));
 }
 
-CellBounds predictedCells(const PlanarTrack& track, double age_s, const PredictionConfig& config,
-                          const GridGeometry& geometry, std::vector<std::size_t>* cells) {
+// predictedCells() once the track and the config are known to be valid.
+CellBounds sweptCells(const PlanarTrack& track, double age_s, const PredictionConfig& config,
+                      const GridGeometry& geometry, std::vector<std::size_t>* cells) {
   CellBounds bounds;
-  if (!track.validate().empty() || !(std::isfinite(age_s) && age_s >= 0.0)) return bounds;
   if (track.velocity.norm() > config.max_speed_mps) return bounds;
   const double duration = age_s + config.prediction_horizon_s;
-  const Footprint hull = sweptPolygon(track, duration, config);
-  const double grow = uncertaintyRadius(track, duration, config);
+  const Footprint hull = sweptHull(track, duration, config);
+  const double grow = radiusOf(track, duration, config);
   const std::size_t first = cells->size();
 
   // Cells whose centre lies within `grow` of the hull, over the hull's bounding box.
@@ -173,11 +194,44 @@ CellBounds predictedCells(const PlanarTrack& track, double age_s, const Predicti
   return bounds;
 }
 
+}  // namespace
+
+double uncertaintyRadius(const PlanarTrack& track, double dt_s, const PredictionConfig& config) {
+  throwIfInvalid(track, std::abs(dt_s), config);  // dt enters squared: either sign
+  return radiusOf(track, dt_s, config);
+}
+
+Footprint sweptPolygon(const PlanarTrack& track, double duration_s,
+                       const PredictionConfig& config) {
+  throwIfInvalid(track, duration_s, config);
+  return sweptHull(track, duration_s, config);
+}
+
+CellBounds predictedCells(const PlanarTrack& track, double age_s, const PredictionConfig& config,
+                          const GridGeometry& geometry, std::vector<std::size_t>* cells) {
+  if (!validatePrediction(track, age_s, config).empty()) return {};
+  return sweptCells(track, age_s, config, geometry, cells);
+}
+
+std::string recentCellsReason(const PlanarTrack& track, double lookback_s, double age_s,
+                              double margin_m, double max_object_size_m) {
+  const std::string why = track.validate();
+  if (!why.empty()) return "track: " + why;
+  const auto bad = [](double v) { return !(std::isfinite(v) && v >= 0.0); };
+  std::ostringstream out;
+  if (bad(lookback_s) || bad(age_s)) {
+    out << "lookback_s and age_s must be finite and >= 0 s, got " << lookback_s << " and " << age_s;
+  } else if (bad(margin_m) || bad(max_object_size_m)) {
+    out << "margin_m and max_object_size_m must be finite and >= 0 m, got " << margin_m << " and "
+        << max_object_size_m;
+  }
+  return out.str();
+}
+
 CellBounds recentCells(const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
                        double max_object_size_m, const GridGeometry& geometry,
                        std::vector<std::size_t>* cells) {
-  const auto bad = [](double v) { return !(std::isfinite(v) && v >= 0.0); };
-  if (bad(lookback_s) || bad(age_s) || bad(margin_m) || bad(max_object_size_m)) return {};
+  if (!recentCellsReason(track, lookback_s, age_s, margin_m, max_object_size_m).empty()) return {};
   // The same sweep as a prediction, started lookback_s earlier, with the box grown and no
   // uncertainty: only where the object has been, not where it may go.
   PlanarTrack earlier = track;
@@ -189,7 +243,8 @@ CellBounds recentCells(const PlanarTrack& track, double lookback_s, double age_s
   sweep.uncertainty_sigmas = 0.0;
   sweep.max_object_size_m = max_object_size_m + 2.0 * margin_m;
   sweep.max_speed_mps = std::numeric_limits<double>::infinity();
-  return predictedCells(earlier, lookback_s + age_s, sweep, geometry, cells);
+  if (!earlier.validate().empty()) return {};  // a position or size that overflowed
+  return sweptCells(earlier, lookback_s + age_s, sweep, geometry, cells);
 }
 
 }  // namespace downstream_perception

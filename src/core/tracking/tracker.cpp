@@ -40,6 +40,7 @@ void TrackerStats::accumulate(const TrackerStats& o) {
   detections += o.detections;
   detections_ignored_low_score += o.detections_ignored_low_score;
   detections_rejected_invalid += o.detections_rejected_invalid;
+  detections_rejected_out_of_range += o.detections_rejected_out_of_range;
   matched_first_pass += o.matched_first_pass;
   matched_second_pass += o.matched_second_pass;
   unmatched_outside_gate += o.unmatched_outside_gate;
@@ -54,18 +55,37 @@ void TrackerStats::accumulate(const TrackerStats& o) {
 
 namespace {
 
-bool validDetection(const Detection& d, TrackerConfig::Mode mode) {
-  if (!std::isfinite(d.score)) return false;
+enum class Verdict { kOk, kInvalid, kOutOfRange };
+
+Verdict checkDetection(const Detection& d, TrackerConfig::Mode mode) {
+  if (!std::isfinite(d.score)) return Verdict::kInvalid;
+  const auto beyond = [](double v, double limit) { return std::abs(v) > limit; };
   if (mode == TrackerConfig::Mode::kImage) {
-    return d.box.validate().empty() && d.box.height() > 0.0 && d.box.width() > 0.0;
+    const Box& b = d.box;
+    if (!b.validate().empty() || !(b.height() > 0.0) || !(b.width() > 0.0)) {
+      return Verdict::kInvalid;
+    }
+    const double limit = TrackerConfig::kMaxBoxCoordinatePx;
+    return beyond(b.x_min, limit) || beyond(b.y_min, limit) || beyond(b.x_max, limit) ||
+                   beyond(b.y_max, limit)
+               ? Verdict::kOutOfRange
+               : Verdict::kOk;
   }
   if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.cov_xx) ||
       !std::isfinite(d.cov_xy) || !std::isfinite(d.cov_yy) || !std::isfinite(d.size_x) ||
-      !std::isfinite(d.size_y)) {
-    return false;
+      !std::isfinite(d.size_y) || d.size_x < 0.0 || d.size_y < 0.0) {
+    return Verdict::kInvalid;
+  }
+  const double limit = TrackerConfig::kMaxPositionM;
+  if (beyond(d.x, limit) || beyond(d.y, limit) || d.size_x > limit || d.size_y > limit ||
+      beyond(d.cov_xx, limit * limit) || beyond(d.cov_xy, limit * limit) ||
+      beyond(d.cov_yy, limit * limit)) {
+    return Verdict::kOutOfRange;
   }
   // A covariance must be symmetric positive semi-definite (all zero = "use the default").
-  return d.cov_xx >= 0.0 && d.cov_yy >= 0.0 && d.cov_xx * d.cov_yy - d.cov_xy * d.cov_xy >= 0.0;
+  return d.cov_xx >= 0.0 && d.cov_yy >= 0.0 && d.cov_xx * d.cov_yy - d.cov_xy * d.cov_xy >= 0.0
+             ? Verdict::kOk
+             : Verdict::kInvalid;
 }
 
 }  // namespace
@@ -376,8 +396,10 @@ struct Core : Tracker::Impl {
     std::vector<std::size_t> high, low;
     for (std::size_t j = 0; j < detections.size(); ++j) {
       const Detection& d = detections[j];
-      if (!validDetection(d, config.mode)) {
-        ++stats.detections_rejected_invalid;
+      const Verdict verdict = checkDetection(d, config.mode);
+      if (verdict != Verdict::kOk) {
+        ++(verdict == Verdict::kInvalid ? stats.detections_rejected_invalid
+                                        : stats.detections_rejected_out_of_range);
         continue;
       }
       if (d.score < config.low_score || (d.score < config.high_score && !config.second_pass)) {

@@ -48,19 +48,27 @@ struct PlanarTrack {
   std::string validate() const;
 };
 
+/// Empty if a prediction from `track` over `time_s` with `config` is possible (track.validate(),
+/// config.validate(), time_s finite and >= 0), else the reason. The functions below check it.
+std::string validatePrediction(const PlanarTrack& track, double time_s,
+                               const PredictionConfig& config);
+
 /// The track's predicted position after dt_s (constant velocity).
 Eigen::Vector2d predictPosition(const PlanarTrack& track, double dt_s);
 /// Growth radius (m) for the predicted position dt_s after the stamp: k·sqrt(λmax(Σp + dt² Σv)),
-/// capped at max_uncertainty_m.
+/// capped at max_uncertainty_m. Throws std::invalid_argument if validatePrediction() fails.
 double uncertaintyRadius(const PlanarTrack& track, double dt_s, const PredictionConfig& config);
 
 /// The convex polygon swept by the track's box from its stamp over duration_s (counter-clockwise;
-/// fewer than 3 vertices when the box has no area: a segment or a point).
+/// fewer than 3 vertices when the box has no area: a segment or a point). Throws
+/// std::invalid_argument if validatePrediction() fails.
 Footprint sweptPolygon(const PlanarTrack& track, double duration_s, const PredictionConfig& config);
 
 /// Cells covered by the track from its stamp over age_s + prediction_horizon_s (age_s = now -
 /// stamp, >= 0), clipped to the grid. Appends linear indices to *cells (each once) and returns the
-/// window they span (empty if none).
+/// window they span (empty if none). Called per track on message data, so it does not throw:
+/// nothing is appended (and the window is empty) if validatePrediction() fails or the track is
+/// faster than max_speed_mps.
 CellBounds predictedCells(const PlanarTrack& track, double age_s, const PredictionConfig& config,
                           const GridGeometry& geometry, std::vector<std::size_t>* cells);
 
@@ -68,9 +76,13 @@ CellBounds predictedCells(const PlanarTrack& track, double age_s, const Predicti
 /// swept from lookback_s before its stamp to age_s after it: where the object's own sensor returns
 /// have recently landed and where it is now. The obstacle layer clears these cells
 /// (clear_tracked_objects) so that a tracked object is drawn once, by its prediction. Appends to
-/// *cells like predictedCells().
+/// *cells like predictedCells(); nothing if recentCellsReason() is not empty.
 CellBounds recentCells(const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
                        double max_object_size_m, const GridGeometry& geometry,
                        std::vector<std::size_t>* cells);
+/// Empty if recentCells() can sweep `track` with these values (track.validate(), the times,
+/// margin and size finite and >= 0), else the reason.
+std::string recentCellsReason(const PlanarTrack& track, double lookback_s, double age_s,
+                              double margin_m, double max_object_size_m);
 
 }  // namespace downstream_perception

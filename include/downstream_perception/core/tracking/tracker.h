@@ -49,6 +49,14 @@ struct Detection {
 };
 
 struct TrackerConfig {
+  /// Image mode: largest accepted |box coordinate| (px). Far above any sensor's resolution;
+  /// a box at 1e308 px made the track covariance infinite.
+  static constexpr double kMaxBoxCoordinatePx = 1e6;
+  /// Metric mode: largest accepted |position| and size (m), and (its square) covariance entry
+  /// (m^2). Above every earth-fixed frame (UTM northings < 1e7 m, ECEF < 6.4e6 m), far below
+  /// where the filter's arithmetic would overflow.
+  static constexpr double kMaxPositionM = 1e8;
+
   enum class Mode { kMetric, kImage };
   Mode mode = Mode::kMetric;
   double gate_confidence = 0.999;  ///< chi-square gate (metric): 2 dof, 0.99 -> 9.21, 0.999 -> 13.8
@@ -101,7 +109,11 @@ struct Track {
 struct TrackerStats {
   std::size_t detections = 0;
   std::size_t detections_ignored_low_score = 0;
-  std::size_t detections_rejected_invalid = 0;  ///< NaN/Inf or malformed boxes
+  /// NaN/Inf, boxes with min > max or no area, negative sizes, covariances that are not
+  /// positive semi-definite
+  std::size_t detections_rejected_invalid = 0;
+  /// Finite but beyond TrackerConfig::kMaxBoxCoordinatePx (image) or kMaxPositionM (metric)
+  std::size_t detections_rejected_out_of_range = 0;
   std::size_t matched_first_pass = 0;
   std::size_t matched_second_pass = 0;
   std::size_t unmatched_outside_gate = 0;  ///< high-score detections no track could take
