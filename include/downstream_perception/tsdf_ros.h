@@ -98,6 +98,7 @@ class TsdfRos {
   /// Inserts into the OctoMap on its own thread; null when ~octomap_resolution_m is 0.
   std::unique_ptr<OctreeWorker> octree_;
   std::atomic<std::size_t> octree_occupied_{0};  ///< set by the publishing timer
+  std::size_t octree_max_memory_bytes_ = 0;      ///< ~octomap_max_memory_mb
   TsdfSliceConfig slice_;
   bool slice_changed_ = false;         ///< the band moved: re-slice at the next mesh tick
   double slice_distance_max_m_ = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
@@ -116,6 +117,7 @@ class TsdfRos {
   std::size_t pixels_invalid_ = 0;
   std::size_t blocks_refused_ = 0;
   std::size_t blocks_evicted_ = 0;
+  std::size_t pixels_no_return_ignored_ = 0;  ///< +Inf pixels carving refused to use (total)
   RunningStats integrate_ms_;
   RunningStats mesh_ms_;
   std::size_t mesh_triangles_ = 0;

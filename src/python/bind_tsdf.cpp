@@ -84,6 +84,8 @@ void bindOctree(py::module& m) {
       .def_readwrite("prob_miss", &OctreeConfig::prob_miss)
       .def_readwrite("max_range_m", &OctreeConfig::max_range_m)
       .def_readwrite("depth_stride_px", &OctreeConfig::depth_stride_px)
+      .def_readwrite("max_distance_m", &OctreeConfig::max_distance_m)
+      .def_readwrite("max_memory_bytes", &OctreeConfig::max_memory_bytes)
       .def("validate", &OctreeConfig::validate);
   py::class_<OccupancyOctree>(m, "OccupancyOctree",
                               "OctoMap occupancy (octomap::OcTree) from the same observations.")
@@ -140,6 +142,34 @@ void bindOctree(py::module& m) {
             if (!why.empty()) throw std::runtime_error(why);
           },
           py::arg("path"))
+      .def(
+          "evict_farther_than",
+          [](OccupancyOctree& self, const Eigen::Vector3d& center, double distance_m) {
+            py::gil_scoped_release release;
+            return self.evictFartherThan(center, distance_m);
+          },
+          py::arg("center"), py::arg("distance_m"),
+          "Deletes the leaves whose centre is farther than distance_m from center; returns the "
+          "number of nodes deleted.")
+      .def(
+          "maintain",
+          [](OccupancyOctree& self, const Eigen::Vector3d& sensor_origin) {
+            OctreeMaintenance m;
+            {
+              py::gil_scoped_release release;
+              m = self.maintain(sensor_origin);
+            }
+            py::dict out;
+            out["nodes_evicted_by_distance"] = m.nodes_evicted_by_distance;
+            out["nodes_evicted_at_cap"] = m.nodes_evicted_at_cap;
+            out["leaves"] = m.leaves;
+            out["memory_bytes"] = m.memory_bytes;
+            return out;
+          },
+          py::arg("sensor_origin"),
+          "Applies the config's max_distance_m and max_memory_bytes around the sensor and prunes; "
+          "returns what it deleted and the size after.")
+      .def_property_readonly("node_count", &OccupancyOctree::nodeCount)
       .def_property_readonly("leaf_count", &OccupancyOctree::leafCount)
       .def_property_readonly("memory_bytes", &OccupancyOctree::memoryBytes)
       .def("clear", &OccupancyOctree::clear);
@@ -160,6 +190,8 @@ void bindTsdf(py::module& m) {
       .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad)
       .def_readwrite("interpolate_depth", &TsdfConfig::interpolate_depth)
       .def_readwrite("carve_free_space", &TsdfConfig::carve_free_space)
+      .def_readwrite("no_return_carve_min_valid_fraction",
+                     &TsdfConfig::no_return_carve_min_valid_fraction)
       .def_readwrite("min_depth_m", &TsdfConfig::min_depth_m)
       .def_readwrite("max_depth_m", &TsdfConfig::max_depth_m)
       .def_readwrite("min_weight", &TsdfConfig::min_weight)
@@ -187,6 +219,13 @@ void bindTsdf(py::module& m) {
       .def_readonly("pixels_valid", &TsdfIntegrationStats::pixels_valid)
       .def_readonly("pixels_invalid", &TsdfIntegrationStats::pixels_invalid)
       .def_readonly("pixels_no_return", &TsdfIntegrationStats::pixels_no_return)
+      .def_readonly("pixels_no_return_ignored", &TsdfIntegrationStats::pixels_no_return_ignored)
+      .def_property_readonly(
+          "refused",
+          [](const TsdfIntegrationStats& s) -> py::object {
+            return s.refused == nullptr ? py::object(py::none()) : py::str(s.refused);
+          },
+          "Why the whole frame was refused (its pixels counted invalid), or None.")
       .def_readonly("blocks_touched", &TsdfIntegrationStats::blocks_touched)
       .def_readonly("blocks_allocated", &TsdfIntegrationStats::blocks_allocated)
       .def_readonly("blocks_refused", &TsdfIntegrationStats::blocks_refused)
@@ -206,7 +245,8 @@ void bindTsdf(py::module& m) {
           },
           py::arg("config"),
           "Replaces the settings that keep the voxel lattice (weights, depth limits, edge guard, "
-          "memory bounds); raises ValueError for an invalid config or another voxel_size_m or "
+          "memory bounds; a lower max_blocks evicts the least recently updated blocks at once); "
+          "raises ValueError for an invalid config or another voxel_size_m or "
           "truncation_voxels.")
       .def(
           "integrate_depth",
@@ -258,7 +298,8 @@ void bindTsdf(py::module& m) {
             py::array_t<double> distance(n), weight(n);
             const double mu = self.map.config().truncation();
             for (py::ssize_t i = 0; i < n; ++i) {
-              const TsdfVoxel* v = self.map.voxel(self.map.voxelAt(points.row(i).transpose()));
+              // Far or NaN points have no voxel (NaN, weight 0), not a clamped index's.
+              const TsdfVoxel* v = self.map.voxelNear(points.row(i).transpose());
               const bool known = v != nullptr && v->weight > self.map.config().min_weight;
               distance.mutable_at(i) = known ? v->distance * mu : std::nan("");
               weight.mutable_at(i) = v == nullptr ? 0.0 : v->weight;
@@ -316,6 +357,9 @@ void bindTsdf(py::module& m) {
           "below 0.5, and double crossings within mu (pose drift's fingerprint).")
       .def_property_readonly("block_count", [](const Tsdf& t) { return t.map.blockCount(); })
       .def_property_readonly("memory_bytes", [](const Tsdf& t) { return t.map.memoryBytes(); })
+      .def_property_readonly(
+          "blocks_evicted_to_cap", [](const Tsdf& t) { return t.map.blocksEvictedToCap(); },
+          "Blocks evicted because set_config lowered max_blocks below the block count (total).")
       .def("clear", [](Tsdf& self) {
         self.map.clear();
         self.mesher.clear();

@@ -21,6 +21,8 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   pnh.param("behind_surface_dropoff", c.behind_surface_dropoff, c.behind_surface_dropoff);
   pnh.param("interpolate_depth", c.interpolate_depth, c.interpolate_depth);
   pnh.param("carve_free_space", c.carve_free_space, c.carve_free_space);
+  pnh.param("no_return_carve_min_valid_fraction", c.no_return_carve_min_valid_fraction,
+            c.no_return_carve_min_valid_fraction);
   pnh.param("edge_guard_rad", c.edge_guard_rad, c.edge_guard_rad);
   pnh.param("min_depth_m", c.min_depth_m, c.min_depth_m);
   pnh.param("max_depth_m", c.max_depth_m, c.max_depth_m);

@@ -89,6 +89,16 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
   pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
   octree.max_range_m = map_->config().max_depth_m;
+  octree.max_distance_m = map_->config().max_block_distance_m;  // the TSDF's bound
+  double octree_max_memory_mb = static_cast<double>(octree.max_memory_bytes) / (1 << 20);
+  pnh_.param("octomap_max_memory_mb", octree_max_memory_mb, octree_max_memory_mb);
+  if (!(std::isfinite(octree_max_memory_mb) && octree_max_memory_mb >= 1.0 &&
+        octree_max_memory_mb <= 1e6)) {
+    config_errors_.add("parameter ~octomap_max_memory_mb = " + toText(octree_max_memory_mb) +
+                       " must be in [1, 1e6] MiB; using 256");
+    octree_max_memory_mb = 256.0;
+  }
+  octree.max_memory_bytes = static_cast<std::size_t>(octree_max_memory_mb * (1 << 20));
   int octree_queue = 2;
   pnh_.param("octomap_queue_size", octree_queue, octree_queue);
   if (octree_queue < 1 || octree_queue > 100) {
@@ -100,7 +110,9 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     if (!why.empty()) {
       config_errors_.add("OctoMap parameters invalid (" + why + "); using the defaults");
       octree = OctreeConfig{};
+      octree.max_distance_m = map_->config().max_block_distance_m;
     }
+    octree_max_memory_bytes_ = octree.max_memory_bytes;
     octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octree),
                                              static_cast<std::size_t>(octree_queue));
   }
@@ -172,6 +184,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.edge_guard_rad = cfg.edge_guard_rad;
   next.interpolate_depth = cfg.interpolate_depth;
   next.carve_free_space = cfg.carve_free_space;
+  next.no_return_carve_min_valid_fraction = cfg.no_return_carve_min_valid_fraction;
   next.min_depth_m = cfg.min_depth_m;
   next.max_depth_m = cfg.max_depth_m;
   next.min_weight = cfg.min_weight;
@@ -195,6 +208,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   }
   if (!why.empty())
     config_errors_.add("live TSDF parameters refused (" + why + "); keeping the previous");
+  if (octree_) octree_->setMaxDistance(now.max_block_distance_m);  // valid: the map took it
   if (!slice_why.empty()) {
     config_errors_.add("live slice band refused (" + slice_why + "); keeping [" +
                        toText(slice.min_z_m) + ", " + toText(slice.max_z_m) + "] m");
@@ -228,11 +242,17 @@ void TsdfRos::onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
 }
 
 void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
+  if (stats.refused != nullptr) {  // counted as rejected, like the node's own checks
+    ++rejected_[std::string("integrator: ") + stats.refused];
+    ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s", stats.refused);
+    return;
+  }
   ++frames_integrated_;
   last_ = stats;
   pixels_invalid_ += stats.pixels_invalid;
   blocks_refused_ += stats.blocks_refused;
   blocks_evicted_ += stats.blocks_evicted;
+  pixels_no_return_ignored_ += stats.pixels_no_return_ignored;
   integrate_ms_.add(elapsed_ms);
 }
 
@@ -473,6 +493,9 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("memory (MB)", static_cast<double>(map_->memoryBytes()) / 1e6);
   status.add("blocks refused at max_blocks (total)", blocks_refused_);
   status.add("blocks evicted by distance (total)", blocks_evicted_);
+  status.add("blocks evicted to a lowered max_blocks (total)", map_->blocksEvictedToCap());
+  status.add("no-return pixels not carved: too few valid depths in their frame (total)",
+             pixels_no_return_ignored_);
   status.add("mesh triangles", mesh_triangles_);
   status.add("slice: occupied cells", slice_stats_.cells_occupied);
   status.add("slice band (m)", toText(slice_.min_z_m) + " .. " + toText(slice_.max_z_m));
@@ -488,8 +511,14 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     status.add("octomap: observations dropped (queue full: insertion slower than the sensor)",
                octree.dropped);
     status.add("octomap: leaves", octree.leaves);
+    status.add("octomap: nodes", octree.nodes);
     status.add("octomap: occupied leaves", octree_occupied_.load());
     status.add("octomap: memory (MB)", static_cast<double>(octree.memory_bytes) / 1e6);
+    status.add("octomap: memory cap (MB)", static_cast<double>(octree_max_memory_bytes_) / 1e6);
+    status.add("octomap: nodes evicted by distance (total)", octree.nodes_evicted_by_distance);
+    status.add("octomap: nodes evicted at the memory cap (total)", octree.nodes_evicted_at_cap);
+    status.add("octomap: maintenance time mean (ms)", octree.maintenance_ms.mean());
+    status.add("octomap: maintenance time max (ms)", octree.maintenance_ms.max);
     status.add("octomap: insertion time mean (ms)", octree.insert_ms.mean());
     status.add("octomap: insertion time max (ms)", octree.insert_ms.max);
   }

@@ -218,7 +218,9 @@ TEST(Tsdf, CarvingErasesWhatMovedAway) {
   EXPECT_GT(carved_far, 100u);
   EXPECT_GT(carved_blocks, band_blocks);  // the free space in front of the walls is allocated
 
-  // No return anywhere: free along every ray up to max_depth_m, and only with carving.
+  // No return anywhere: free along every ray up to max_depth_m, only with carving, and only
+  // when the frame's returns need not be evidence (no_return_carve_min_valid_fraction 0; see
+  // NoReturnFrameWithoutReturnsCarvesNothing for the default).
   TsdfConfig c;
   c.voxel_size_m = 0.05;
   c.max_depth_m = 3.0;
@@ -227,6 +229,7 @@ TEST(Tsdf, CarvingErasesWhatMovedAway) {
   integrateDepth(&plain, nothing.data(), camera, Eigen::Isometry3d::Identity());
   EXPECT_EQ(plain.blockCount(), 0u);
   c.carve_free_space = true;
+  c.no_return_carve_min_valid_fraction = 0.0;
   TsdfMap carved(c);
   const TsdfIntegrationStats stats =
       integrateDepth(&carved, nothing.data(), camera, Eigen::Isometry3d::Identity());
@@ -435,6 +438,8 @@ TEST(Tsdf, InvalidDepthsAreCountedNotFused) {
   PinholeCamera camera = smallCamera();
   camera.width = 4;
   camera.height = 1;
+  camera.cx = 1.5;
+  camera.cy = 0.0;
   const float inf = std::numeric_limits<float>::infinity();
   const std::vector<float> depth = {std::nanf(""), 0.0f, -inf, inf};
   const TsdfIntegrationStats s =
@@ -777,4 +782,270 @@ TEST(OccupancyOctree, DepthImageOfAPlaneMarksThePlane) {
   double l = 0.0;
   ASSERT_TRUE(tree.logOdds(Eigen::Vector3d(0.0, 0.0, 0.8), &l));
   EXPECT_LT(l, 0.0);  // free space in front of it
+}
+
+namespace {
+
+/// Voxels (weight or distance) that differ between two maps, over the union of their blocks.
+std::size_t differingVoxels(const TsdfMap& a, const TsdfMap& b) {
+  std::size_t n = 0;
+  const auto count = [&n](const TsdfMap& x, const TsdfMap& y, bool both_ways) {
+    for (const auto& kv : x.blocks()) {
+      const TsdfBlock* other = y.find(kv.first);
+      if (other == nullptr) {
+        n += kTsdfBlockVoxels;
+        continue;
+      }
+      if (!both_ways) continue;
+      for (int i = 0; i < kTsdfBlockVoxels; ++i) {
+        n += kv.second->voxels[i].distance != other->voxels[i].distance ||
+             kv.second->voxels[i].weight != other->voxels[i].weight;
+      }
+    }
+  };
+  count(a, b, true);
+  count(b, a, false);
+  return n;
+}
+
+}  // namespace
+
+TEST(Tsdf, NoReturnFrameWithoutReturnsCarvesNothing) {
+  // Carving, ten frames of a wall 1.013 m ahead with one frame without any return (+Inf
+  // everywhere: a failing sensor) in the middle. That frame carries no evidence (no valid depth):
+  // its +Inf pixels are ignored and counted, and the map is bit for bit the map without it.
+  // With no_return_carve_min_valid_fraction 0 the frame carves through the wall.
+  const PinholeCamera camera = smallCamera();
+  const std::vector<float> wall = planeDepth(camera, Eigen::Vector3d::UnitZ(), 1.013);
+  const std::vector<float> nothing(wall.size(), std::numeric_limits<float>::infinity());
+  const auto run = [&](bool bad_frame, double fraction, TsdfIntegrationStats* bad_stats) {
+    TsdfConfig c;
+    c.voxel_size_m = 0.05;
+    c.carve_free_space = true;
+    c.no_return_carve_min_valid_fraction = fraction;
+    auto map = std::make_unique<TsdfMap>(c);
+    DepthIntegrator integrator;
+    for (int k = 0; k < 10; ++k) {
+      integrator.integrate(map.get(), wall.data(), camera, Eigen::Isometry3d::Identity());
+      if (bad_frame && k == 4) {
+        *bad_stats =
+            integrator.integrate(map.get(), nothing.data(), camera, Eigen::Isometry3d::Identity());
+      }
+    }
+    return map;
+  };
+  TsdfIntegrationStats bad;
+  const auto reference = run(false, 0.5, &bad);
+  const auto guarded = run(true, 0.5, &bad);
+  EXPECT_EQ(bad.pixels_no_return, wall.size());
+  EXPECT_EQ(bad.pixels_no_return_ignored, wall.size());
+  EXPECT_EQ(bad.voxels_updated, 0u);
+  EXPECT_EQ(bad.blocks_allocated, 0u);
+  EXPECT_EQ(guarded->blockCount(), reference->blockCount());
+  EXPECT_EQ(differingVoxels(*reference, *guarded), 0u);
+  const auto unguarded = run(true, 0.0, &bad);
+  EXPECT_EQ(bad.pixels_no_return_ignored, 0u);
+  EXPECT_GT(differingVoxels(*reference, *unguarded), 1000u);  // carved through the wall
+
+  // Half the frame returns (the left half sees the wall), half is +Inf: at the default 0.5 the
+  // returns are evidence enough, the +Inf rays carve; at 0.6 they do not.
+  std::vector<float> half = wall;
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = camera.width / 2; u < camera.width; ++u) {
+      half[static_cast<std::size_t>(v) * camera.width + u] = std::numeric_limits<float>::infinity();
+    }
+  }
+  const Eigen::Vector3d on_inf_ray(1.2, 0.0, 2.5);  // x/z = 0.48: the image's right half
+  for (const double fraction : {0.5, 0.6}) {
+    TsdfConfig c;
+    c.voxel_size_m = 0.05;
+    c.carve_free_space = true;
+    c.no_return_carve_min_valid_fraction = fraction;
+    TsdfMap map(c);
+    const TsdfIntegrationStats s =
+        integrateDepth(&map, half.data(), camera, Eigen::Isometry3d::Identity());
+    const TsdfVoxel* v = map.voxelNear(on_inf_ray);
+    if (fraction == 0.5) {
+      EXPECT_EQ(s.pixels_no_return_ignored, 0u);
+      ASSERT_NE(v, nullptr);
+      EXPECT_EQ(v->distance, 1.0f);
+    } else {
+      EXPECT_EQ(s.pixels_no_return_ignored, half.size() / 2);
+      EXPECT_TRUE(v == nullptr || v->weight == 0.0f);
+    }
+  }
+  TsdfConfig bad_fraction;
+  bad_fraction.no_return_carve_min_valid_fraction = 1.5;
+  EXPECT_NE(bad_fraction.validate().find("no_return_carve_min_valid_fraction"), std::string::npos);
+}
+
+TEST(Tsdf, CameraWithAPrincipalPointFarOutsideOrAnAbsurdViewIsRefused) {
+  PinholeCamera far = smallCamera();
+  far.cx = 1e7;  // made one carving frame allocate every block the map allowed
+  EXPECT_NE(far.validate().find("principal point"), std::string::npos) << far.validate();
+  PinholeCamera edge = smallCamera();
+  edge.cx = 3.0 * edge.width;  // two image widths beyond the image: still accepted
+  edge.cy = -2.0 * edge.height;
+  EXPECT_EQ(edge.validate(), "");
+  edge.cy -= 1.0;
+  EXPECT_NE(edge.validate().find("principal point"), std::string::npos);
+  PinholeCamera wide = smallCamera();
+  wide.fx = 5.0;  // the image's edge 16 focal lengths off the axis
+  EXPECT_NE(wide.validate().find("view too wide"), std::string::npos) << wide.validate();
+
+  // The integrator refuses such a frame itself (a caller that did not validate): nothing
+  // allocated, every pixel counted invalid.
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  c.carve_free_space = true;
+  c.max_blocks = 2000;
+  TsdfMap map(c);
+  const std::vector<float> depth(static_cast<std::size_t>(far.width) * far.height, 1.0f);
+  const TsdfIntegrationStats s =
+      integrateDepth(&map, depth.data(), far, Eigen::Isometry3d::Identity());
+  ASSERT_NE(s.refused, nullptr);
+  EXPECT_EQ(map.blockCount(), 0u);
+  EXPECT_EQ(s.pixels_invalid, depth.size());
+  EXPECT_EQ(s.pixels_valid, 0u);
+}
+
+TEST(Tsdf, CarvedBlocksLieInTheViewFrustum) {
+  // An off-axis camera (principal point an image width left of the image: every ray points
+  // right), a wall and a no-return patch, carving up to max_depth_m: every allocated block
+  // touches the view frustum between the camera and max_depth_m (checked on the frustum grown
+  // by a block's half diagonal and mu).
+  PinholeCamera camera = smallCamera();
+  camera.cx = -camera.width;
+  ASSERT_EQ(camera.validate(), "");
+  std::vector<float> depth = planeDepth(camera, Eigen::Vector3d::UnitZ(), 1.5);
+  for (std::size_t i = 0; i < depth.size() / 4; ++i) {
+    depth[i] = std::numeric_limits<float>::infinity();
+  }
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  c.carve_free_space = true;
+  c.max_depth_m = 3.0;
+  TsdfMap map(c);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, 0.1).normalized()).matrix();
+  T.translation() = Eigen::Vector3d(0.4, -0.2, 0.7);
+  const TsdfIntegrationStats s = integrateDepth(&map, depth.data(), camera, T);
+  ASSERT_GT(s.blocks_allocated, 100u);
+  const double block_m = kTsdfBlockSide * c.voxel_size_m;
+  const double margin = 0.5 * std::sqrt(3.0) * block_m + c.truncation();
+  const double x_lo = (-0.5 - camera.cx) / camera.fx,
+               x_hi = (camera.width - 0.5 - camera.cx) / camera.fx;
+  const double y_lo = (-0.5 - camera.cy) / camera.fy,
+               y_hi = (camera.height - 0.5 - camera.cy) / camera.fy;
+  const Eigen::Isometry3d T_camera_map = T.inverse();
+  for (const auto& kv : map.blocks()) {
+    const Eigen::Vector3d centre =
+        T_camera_map * ((kv.first.cast<double>() + Eigen::Vector3d::Constant(0.5)) * block_m -
+                        Eigen::Vector3d::Constant(0.5 * c.voxel_size_m));
+    const double z = std::max(centre.z(), 0.0);
+    ASSERT_GT(centre.z(), -margin);
+    ASSERT_LT(centre.z(), c.max_depth_m + margin);
+    ASSERT_GT(centre.x(), x_lo * z - margin) << kv.first.transpose();
+    ASSERT_LT(centre.x(), x_hi * z + margin) << kv.first.transpose();
+    ASSERT_GT(centre.y(), y_lo * z - margin);
+    ASSERT_LT(centre.y(), y_hi * z + margin);
+  }
+}
+
+TEST(Tsdf, FarAndNanPointsAreInvalidNotOverflowed) {
+  // Points, sensor origins and camera poses whose voxel index would not fit in an int (5e9
+  // voxels at 2 cm: 1e8 m) or NaN are refused and counted as invalid; before, the float-to-int
+  // conversion overflowed (undefined; in practice blocks at INT_MIN were allocated).
+  TsdfMap map;
+  const double far = 1e8;
+  const std::vector<Eigen::Vector3d> near_far_origin = {Eigen::Vector3d(far + 1.0, 0.0, 0.0)};
+  TsdfIntegrationStats s = integratePoints(&map, near_far_origin, Eigen::Vector3d(far, 0.0, 0.0));
+  EXPECT_NE(s.refused, nullptr);
+  EXPECT_EQ(s.pixels_invalid, 1u);
+  EXPECT_EQ(s.pixels_valid, 0u);
+  EXPECT_EQ(map.blockCount(), 0u);
+  const double nan = std::nan("");
+  s = integratePoints(&map, {Eigen::Vector3d(nan, 0.0, 1.0), Eigen::Vector3d(0.0, 0.0, 1.0)},
+                      Eigen::Vector3d::Zero());
+  EXPECT_EQ(s.refused, nullptr);
+  EXPECT_EQ(s.pixels_invalid, 1u);
+  EXPECT_EQ(s.pixels_valid, 1u);
+  const std::size_t blocks = map.blockCount();
+  EXPECT_GT(blocks, 0u);
+  s = integratePoints(&map, near_far_origin, Eigen::Vector3d(nan, 0.0, 0.0));
+  EXPECT_NE(s.refused, nullptr);
+
+  const PinholeCamera camera = smallCamera();
+  const std::vector<float> wall = planeDepth(camera, Eigen::Vector3d::UnitZ(), 1.0);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation().x() = far;
+  s = integrateDepth(&map, wall.data(), camera, T);
+  EXPECT_NE(s.refused, nullptr);
+  EXPECT_EQ(s.pixels_invalid, wall.size());
+  T.translation().x() = 0.0;
+  T.linear()(0, 0) = nan;
+  s = integrateDepth(&map, wall.data(), camera, T);
+  EXPECT_NE(s.refused, nullptr);
+  EXPECT_EQ(map.blockCount(), blocks);
+
+  // Queries: no voxel for far or NaN points (voxelAt clamps instead of overflowing).
+  EXPECT_NE(map.voxelNear(Eigen::Vector3d(0.0, 0.0, 1.0)), nullptr);
+  EXPECT_EQ(map.voxelNear(Eigen::Vector3d(nan, 0.0, 1.0)), nullptr);
+  EXPECT_EQ(map.voxelNear(Eigen::Vector3d(1e300, 0.0, 1.0)), nullptr);
+  EXPECT_EQ(map.voxelAt(Eigen::Vector3d(-1e300, nan, 0.02)),
+            Eigen::Vector3i(-TsdfMap::kMaxVoxelIndex, 0, 1));
+  EXPECT_FALSE(map.inBounds(Eigen::Vector3d(far, 0.0, 0.0)));
+  EXPECT_TRUE(map.inBounds(Eigen::Vector3d(1e6, -1e6, 1e6)));
+}
+
+TEST(Tsdf, LoweringMaxBlocksLiveEvictsTheLeastRecentlyUpdatedFirst) {
+  // Two walls seen from cameras 5 m apart, the second later: lowering max_blocks to the number
+  // of blocks the second frame updated evicts all others (the first frame's, and blocks
+  // allocated but never updated); lowering it further evicts, among the equally recent blocks,
+  // the farthest from the last camera.
+  const PinholeCamera camera = smallCamera();
+  const std::vector<float> wall = planeDepth(camera, Eigen::Vector3d::UnitZ(), 1.0);
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  TsdfMap map(c);
+  Eigen::Isometry3d first = Eigen::Isometry3d::Identity(), second = first;
+  second.translation().x() = 5.0;
+  integrateDepth(&map, wall.data(), camera, first);
+  const std::size_t first_count = map.blockCount();
+  integrateDepth(&map, wall.data(), camera, second);
+  const std::size_t total = map.blockCount();
+  std::size_t second_count = 0;
+  for (const auto& kv : map.blocks()) second_count += kv.second->updated_stamp == map.generation();
+  ASSERT_GT(first_count, 10u);
+  ASSERT_GT(second_count, 10u);
+  ASSERT_LT(second_count, total - first_count + 1);
+  TsdfConfig lower = c;
+  lower.max_blocks = second_count;
+  ASSERT_EQ(map.setConfig(lower), "");
+  EXPECT_EQ(map.blockCount(), second_count);
+  EXPECT_EQ(map.blocksEvictedToCap(), total - second_count);
+  for (const auto& kv : map.blocks()) EXPECT_EQ(kv.second->updated_stamp, map.generation());
+  const auto distances = [&map](const TsdfMap& m) {
+    std::vector<double> d;
+    const double block_m = kTsdfBlockSide * m.voxelSize();
+    for (const auto& kv : m.blocks()) {
+      d.push_back(((kv.first.cast<double>() + Eigen::Vector3d::Constant(0.5)) * block_m -
+                   map.sensorOrigin())
+                      .norm());
+    }
+    return d;
+  };
+  const std::vector<double> before = distances(map);
+  lower.max_blocks = second_count / 2;
+  ASSERT_EQ(map.setConfig(lower), "");
+  EXPECT_EQ(map.blockCount(), second_count / 2);
+  EXPECT_EQ(map.blocksEvictedToCap(), total - second_count / 2);
+  const std::vector<double> after = distances(map);
+  std::vector<double> sorted = before;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_LE(*std::max_element(after.begin(), after.end()), sorted[after.size() - 1]);
+  // The cap holds from then on: a new frame allocates nothing beyond it.
+  const TsdfIntegrationStats s = integrateDepth(&map, wall.data(), camera, first);
+  EXPECT_EQ(map.blockCount(), second_count / 2);
+  EXPECT_GT(s.blocks_refused, 0u);
 }

@@ -132,6 +132,7 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "edge_guard_rad",
         "interpolate_depth",
         "carve_free_space",
+        "no_return_carve_min_valid_fraction",
         "min_depth_m",
         "max_depth_m",
         "min_weight",
@@ -145,3 +146,5 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
     for name, value in d.items():
         if name in documented:
             assert documented[name] == pytest.approx(value) or documented[name] == value, name
+    # The OctoMap's cap, start-up only: the YAML's MiB are OctreeConfig's bytes.
+    assert documented["octomap_max_memory_mb"] * 2**20 == dp.OctreeConfig().max_memory_bytes

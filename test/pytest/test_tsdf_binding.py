@@ -338,3 +338,107 @@ def test_graceful_under_depth_and_pose_noise() -> None:
     for pose, depth in zip(poses, clean, strict=True):
         reference.integrate_depth(depth, camera(cam), pose)
     assert tsdf.health()["double_crossings"] > 3 * reference.health()["double_crossings"]
+
+
+def test_sample_at_a_far_or_nan_point_is_nan() -> None:
+    # A far or NaN point has no voxel: NaN and weight 0, not the origin voxel's values (the
+    # index used to overflow to 0).
+    tsdf = lesson_tsdf()
+    tsdf.integrate_points(np.array([[0.5, 0.0, 0.0]]), np.array([-3.0, 0.0, 0.0]))
+    distance, weight = tsdf.sample(
+        np.array([[0.0, 0.0, 0.0], [np.nan, 0.0, 0.0], [1e300, 0.0, 0.0], [0.0, -1e30, 0.0]])
+    )
+    assert np.isfinite(distance[0]) and weight[0] > 0.0
+    assert np.isnan(distance[1:]).all()
+    np.testing.assert_array_equal(weight[1:], 0.0)
+
+
+def test_far_poses_and_origins_are_refused_and_counted() -> None:
+    tsdf = dp.Tsdf()
+    cam = DepthCamera()
+    far = np.eye(4)
+    far[0, 3] = 1e9
+    stats = tsdf.integrate_depth(np.ones((240, 320), np.float32), camera(cam), far)
+    assert stats.refused is not None and "pose" in stats.refused
+    assert stats.pixels_invalid == 240 * 320
+    stats = tsdf.integrate_points(np.array([[1e9 + 1.0, 0.0, 0.0]]), np.array([1e9, 0.0, 0.0]))
+    assert stats.refused is not None and stats.pixels_invalid == 1
+    assert tsdf.block_count == 0
+    near = tsdf.integrate_depth(np.ones((240, 320), np.float32), camera(cam), np.eye(4))
+    assert near.refused is None
+
+
+def test_camera_with_an_absurd_principal_point_or_view_is_refused() -> None:
+    with pytest.raises(ValueError, match="principal point"):
+        dp.PinholeCamera(262.5, 262.5, 1e7, 119.5, 320, 240)
+    with pytest.raises(ValueError, match="view too wide"):
+        dp.PinholeCamera(1.0, 1.0, 159.5, 119.5, 320, 240)
+    dp.PinholeCamera(262.5, 262.5, 3 * 320, -2 * 240, 320, 240)  # the bounds themselves pass
+
+
+def test_lowering_max_blocks_live_evicts_down_to_the_cap() -> None:
+    tsdf = room_tsdf_5cm()
+    blocks = tsdf.block_count
+    assert blocks > 100
+    config = tsdf.config
+    config.max_blocks = blocks // 5
+    tsdf.set_config(config)
+    assert tsdf.block_count == blocks // 5
+    assert tsdf.blocks_evicted_to_cap == blocks - blocks // 5
+    cam, _, poses, depths, _ = room_frames("qvga")
+    stats = tsdf.integrate_depth(depths[3], camera(cam), poses[3])
+    assert tsdf.block_count <= blocks // 5
+    assert stats.blocks_refused > 0
+
+
+def test_a_frame_without_returns_leaves_the_carved_room_as_without_it() -> None:
+    # Carving, 20 frames of the room with one frame of +Inf only (no return anywhere: a failing
+    # sensor) in the middle. Such a frame is no evidence of free space: it is ignored (counted)
+    # and the mesh scores as without it. Measured: 1.54 mm mean error, 0.40 % ghosts either way
+    # at 5 cm; letting the frame carve (fraction 0) gave 31.6 mm and 27.6 % after one good frame.
+    cam, scene, poses, depths, observed = room_frames("qvga")
+    poses, depths = poses[::3] + poses[1::3][:10], depths[::3] + depths[1::3][:10]
+    scores = {}
+    for bad_frame, fraction in ((False, 0.5), (True, 0.5), (True, 0.0)):
+        config = dp.TsdfConfig()
+        config.voxel_size_m = 0.05
+        config.carve_free_space = True
+        config.no_return_carve_min_valid_fraction = fraction
+        tsdf = dp.Tsdf(config)
+        for k, (pose, depth) in enumerate(zip(poses, depths, strict=True)):
+            tsdf.integrate_depth(depth, camera(cam), pose)
+            if bad_frame and k == 9:
+                stats = tsdf.integrate_depth(np.full_like(depth, np.inf), camera(cam), pose)
+                ignored = stats.pixels_no_return_ignored
+                assert ignored == (depth.size if fraction > 0 else 0)
+        tsdf.update_mesh()
+        mesh = tsdf.mesh()
+        scores[(bad_frame, fraction)] = score_mesh(
+            scene, mesh["vertices"], mesh["triangles"], 0.05, observed
+        )
+    clean, guarded, unguarded = scores[(False, 0.5)], scores[(True, 0.5)], scores[(True, 0.0)]
+    assert abs(guarded.mean_error_m - clean.mean_error_m) < 1e-5
+    assert abs(guarded.ghost_fraction - clean.ghost_fraction) < 1e-4
+    assert guarded.completeness >= clean.completeness - 1e-4
+    assert unguarded.ghost_fraction > clean.ghost_fraction + 0.01  # the frame did carve
+
+
+def test_octree_maintenance_bounds_the_tree_around_the_sensor() -> None:
+    cam = DepthCamera()
+    scene = room_scene()
+    config = dp.OctreeConfig()
+    config.max_distance_m = 1.5
+    tree = dp.OccupancyOctree(config)
+    poses = circle_poses(6)
+    for pose in poses:
+        tree.insert_depth(cam.render(scene, pose), camera(cam), pose)
+    origin = poses[-1][:3, 3]
+    done = tree.maintain(origin)
+    assert done["nodes_evicted_by_distance"] > 0
+    assert done["leaves"] == tree.leaf_count and done["memory_bytes"] == tree.memory_bytes
+    occupied = tree.occupied()
+    assert len(occupied) > 100
+    assert np.linalg.norm(occupied - origin, axis=1).max() <= 1.5
+    assert tree.evict_farther_than(origin, 0.5) > 0
+    assert np.linalg.norm(tree.occupied() - origin, axis=1).max(initial=0.0) <= 0.5
+    assert tree.node_count > 0

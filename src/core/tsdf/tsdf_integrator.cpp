@@ -19,6 +19,22 @@ std::string PinholeCamera::validate() const {
     why << "principal point must be finite";
   } else if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
     why << "image size must be in [1, 16384] pixels, got " << width << " x " << height;
+  } else if (!(cx >= -kMaxPrincipalPointOffset * width &&
+               cx <= (1.0 + kMaxPrincipalPointOffset) * width &&
+               cy >= -kMaxPrincipalPointOffset * height &&
+               cy <= (1.0 + kMaxPrincipalPointOffset) * height)) {
+    why << "principal point (" << cx << ", " << cy << ") px lies more than "
+        << kMaxPrincipalPointOffset << " image sizes outside the " << width << " x " << height
+        << " image";
+  } else {
+    // The pixel rays farthest off the optical axis: the image's outer pixel edges.
+    const double tan_x = std::max(std::abs(-0.5 - cx), std::abs(width - 0.5 - cx)) / fx;
+    const double tan_y = std::max(std::abs(-0.5 - cy), std::abs(height - 0.5 - cy)) / fy;
+    if (!(tan_x <= kMaxViewTangent && tan_y <= kMaxViewTangent)) {
+      why << "view too wide: the image's edge rays are " << std::atan(std::max(tan_x, tan_y))
+          << " rad off the optical axis (at most atan(" << kMaxViewTangent
+          << ") = 1.47 rad); focal lengths fx " << fx << ", fy " << fy << " px";
+    }
   }
   return why.str();
 }
@@ -208,6 +224,16 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   stats->pixels_valid += valid_count;
   stats->pixels_no_return += no_return_count;
   stats->pixels_invalid += n - valid_count - no_return_count;
+  // Carving: +Inf pixels free their rays only in a frame with enough returns (the evidence the
+  // sensor sees); otherwise they become invalid (NaN) for the whole integration. NaN and +Inf
+  // are alike for the edge and interpolation masks below, so only the no-return updates change.
+  if (c.carve_free_space && no_return_count > 0 &&
+      valid_count < c.no_return_carve_min_valid_fraction * static_cast<double>(n)) {
+    for (std::size_t i = 0; i < n; ++i) {
+      out_depth[i] = out_depth[i] == inf ? nan : out_depth[i];
+    }
+    stats->pixels_no_return_ignored += no_return_count;
+  }
   if (c.interpolate_depth) {
     const float max_step = static_cast<float>(c.voxel_size_m);
     f.smooth.resize(n);
@@ -245,10 +271,11 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
 /// same block, so a one-entry cache per sample along the ray skips most hash lookups. The
 /// blocks are listed in the order the image's rows first reach them, so consecutive blocks read
 /// nearby pixels (hash order would scatter the integration's pixel reads over the whole image).
+/// The list stops at max_blocks keys (`truncated`): the map can hold no more.
 DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
                                                             const PinholeCamera& camera,
                                                             const Eigen::Isometry3d& T,
-                                                            const TsdfConfig& c) {
+                                                            const TsdfConfig& c, bool* truncated) {
   tsl::robin_set<Eigen::Vector3i, BlockIndexHash> seen;
   std::vector<Eigen::Vector3i> keys;
   // Without a valid depth only carving (along +Inf rays) has anything to do.
@@ -299,7 +326,12 @@ DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
         const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), 1.0 / s);
         if (key == last[k]) continue;
         last[k] = key;
-        if (seen.insert(key).second) keys.push_back(key);
+        if (!seen.insert(key).second) continue;
+        keys.push_back(key);
+        if (keys.size() >= c.max_blocks) {
+          *truncated = true;
+          return keys;
+        }
       }
     }
   }
@@ -307,8 +339,26 @@ DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
 }
 
 void evict(TsdfMap* map, const Eigen::Vector3d& origin, TsdfIntegrationStats* stats) {
+  map->setSensorOrigin(origin);
   const double limit = map->config().max_block_distance_m;
   if (limit > 0.0) stats->blocks_evicted = map->evictFartherThan(origin, limit);
+}
+
+/// Why a depth frame cannot be integrated at all, or nullptr: invalid intrinsics, or a pose
+/// whose rays (up to max_depth_m, at most atan(kMaxViewTangent) off the axis) could leave the
+/// map's index range (TsdfMap::inBounds), or is not finite.
+const char* refusedFrame(const TsdfMap& map, const PinholeCamera& camera,
+                         const Eigen::Isometry3d& T_map_camera) {
+  if (!camera.validate().empty()) return "invalid camera intrinsics";
+  const TsdfConfig& c = map.config();
+  const double reach =
+      std::sqrt(1.0 + 2.0 * kMaxViewTangent * kMaxViewTangent) * (c.max_depth_m + c.truncation()) +
+      2.0 * kTsdfBlockSide * c.voxel_size_m;
+  if (!T_map_camera.matrix().allFinite() ||
+      !map.inBounds(T_map_camera.translation().cwiseAbs() + Eigen::Vector3d::Constant(reach))) {
+    return "camera pose not finite or beyond the map's index range";
+  }
+  return nullptr;
 }
 
 }  // namespace
@@ -336,10 +386,18 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   const double mu = c.truncation();
   const int w = camera.width;
   const int h = camera.height;
+  stats.refused = refusedFrame(*map, camera, T_map_camera);
+  if (stats.refused != nullptr) {
+    const bool sized = w > 0 && h > 0 && w <= 16384 && h <= 16384;
+    stats.pixels_invalid = sized ? static_cast<std::size_t>(w) * h : 0;
+    return stats;
+  }
   const std::uint64_t generation = map->beginIntegration();
   prepare(depth, camera, c, &stats, scratch);
   const DepthFrame& frame = *scratch;
-  const auto keys = bandBlocks(frame, camera, T_map_camera, c);
+  bool truncated = false;
+  const auto keys = bandBlocks(frame, camera, T_map_camera, c, &truncated);
+  stats.blocks_refused += truncated;
 
   // Every voxel of those blocks, a row of eight at a time, in three passes: project (vectorised),
   // load the pixel data each voxel needs (scalar loads), fuse (vectorised and branch-free, so
@@ -512,6 +570,11 @@ void millimetresToMetres(const std::uint16_t* millimetres, std::size_t count, fl
 TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vector3d>& points,
                                      const Eigen::Vector3d& origin) {
   TsdfIntegrationStats stats;
+  if (!map->inBounds(origin)) {
+    stats.refused = "sensor origin not finite or beyond the map's index range";
+    stats.pixels_invalid = points.size();
+    return stats;
+  }
   const TsdfConfig& c = map->config();
   const double s = c.voxel_size_m;
   const double mu = c.truncation();
@@ -521,7 +584,7 @@ TsdfIntegrationStats integratePoints(TsdfMap* map, const std::vector<Eigen::Vect
   Eigen::Vector3i cached_key(std::numeric_limits<int>::min(), 0, 0);
   TsdfBlock* cached = nullptr;
   for (const Eigen::Vector3d& point : points) {
-    if (!point.allFinite()) {
+    if (!map->inBounds(point)) {  // NaN, Inf, or so far that its voxel index could overflow
       ++stats.pixels_invalid;
       continue;
     }

@@ -1,5 +1,6 @@
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -15,8 +16,13 @@ std::string TsdfConfig::validate() const {
     why << "truncation_voxels must be in [1, 64], got " << truncation_voxels;
   } else if (!(std::isfinite(max_weight) && max_weight >= 0.0)) {
     why << "max_weight must be finite and >= 0 (0 = no cap), got " << max_weight;
-  } else if (!(positive(min_depth_m) && std::isfinite(max_depth_m) && max_depth_m > min_depth_m)) {
-    why << "need 0 < min_depth_m < max_depth_m, got " << min_depth_m << " and " << max_depth_m;
+  } else if (!(positive(min_depth_m) && max_depth_m > min_depth_m && max_depth_m <= 1000.0)) {
+    why << "need 0 < min_depth_m < max_depth_m <= 1000 m, got " << min_depth_m << " and "
+        << max_depth_m;
+  } else if (!(no_return_carve_min_valid_fraction >= 0.0 &&
+               no_return_carve_min_valid_fraction <= 1.0)) {
+    why << "no_return_carve_min_valid_fraction must be in [0, 1], got "
+        << no_return_carve_min_valid_fraction;
   } else if (!(std::isfinite(min_weight) && min_weight >= 0.0)) {
     why << "min_weight must be finite and >= 0, got " << min_weight;
   } else if (!(std::isfinite(edge_guard_rad) && edge_guard_rad >= 0.0 && edge_guard_rad < 0.2)) {
@@ -53,6 +59,7 @@ std::string TsdfMap::setConfig(const TsdfConfig& config) {
   }
   config_ = config;
   weight_cap_ = weightCapOf(config);
+  evictToCap();
   return {};
 }
 
@@ -60,7 +67,19 @@ namespace {
 int floorDiv(int a, int b) {
   return a >= 0 ? a / b : -((-a + b - 1) / b);
 }
+
+/// round(x) as an int, clamped to +-TsdfMap::kMaxVoxelIndex (NaN: 0): no float-to-int overflow.
+int clampedRound(double x) {
+  constexpr double kMax = TsdfMap::kMaxVoxelIndex;
+  if (!(std::abs(x) <= kMax)) return std::isnan(x) ? 0 : (x > 0.0 ? kMax : -kMax);
+  return static_cast<int>(std::lround(x));
+}
 }  // namespace
+
+bool TsdfMap::inBounds(const Eigen::Vector3d& p) const {
+  const double limit = 0.5 * kMaxVoxelIndex * config_.voxel_size_m;
+  return std::abs(p.x()) <= limit && std::abs(p.y()) <= limit && std::abs(p.z()) <= limit;
+}
 
 Eigen::Vector3i TsdfMap::blockOf(const Eigen::Vector3i& v) {
   return {floorDiv(v.x(), kTsdfBlockSide), floorDiv(v.y(), kTsdfBlockSide),
@@ -74,8 +93,7 @@ int TsdfMap::localIndex(const Eigen::Vector3i& v) {
 
 Eigen::Vector3i TsdfMap::voxelAt(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d s = p / config_.voxel_size_m;
-  return {static_cast<int>(std::lround(s.x())), static_cast<int>(std::lround(s.y())),
-          static_cast<int>(std::lround(s.z()))};
+  return {clampedRound(s.x()), clampedRound(s.y()), clampedRound(s.z())};
 }
 
 TsdfBlock* TsdfMap::allocate(const Eigen::Vector3i& block, bool* created) {
@@ -102,6 +120,10 @@ const TsdfVoxel* TsdfMap::voxel(const Eigen::Vector3i& v) const {
   return b == nullptr ? nullptr : &b->voxels[localIndex(v)];
 }
 
+const TsdfVoxel* TsdfMap::voxelNear(const Eigen::Vector3d& p) const {
+  return inBounds(p) ? voxel(voxelAt(p)) : nullptr;
+}
+
 std::size_t TsdfMap::evictFartherThan(const Eigen::Vector3d& center, double distance_m) {
   const double block_m = kTsdfBlockSide * config_.voxel_size_m;
   const double limit2 = distance_m * distance_m;
@@ -118,6 +140,36 @@ std::size_t TsdfMap::evictFartherThan(const Eigen::Vector3d& center, double dist
     }
   }
   return removed;
+}
+
+std::size_t TsdfMap::evictToCap() {
+  if (blocks_.size() <= config_.max_blocks) return 0;
+  struct Candidate {
+    std::uint64_t stamp;
+    double distance2;
+    Eigen::Vector3i key;
+  };
+  const double block_m = kTsdfBlockSide * config_.voxel_size_m;
+  std::vector<Candidate> candidates;
+  candidates.reserve(blocks_.size());
+  for (const auto& kv : blocks_) {
+    const Eigen::Vector3d c = (kv.first.cast<double>() + Eigen::Vector3d::Constant(0.5)) * block_m;
+    candidates.push_back({kv.second->updated_stamp, (c - sensor_origin_).squaredNorm(), kv.first});
+  }
+  // The first `excess` in this order go: oldest update first, then farthest, then by index (so
+  // the choice does not depend on the hash table's order).
+  const auto first_out = [](const Candidate& a, const Candidate& b) {
+    if (a.stamp != b.stamp) return a.stamp < b.stamp;
+    if (a.distance2 != b.distance2) return a.distance2 > b.distance2;
+    return std::lexicographical_compare(a.key.data(), a.key.data() + 3, b.key.data(),
+                                        b.key.data() + 3);
+  };
+  const std::size_t excess = blocks_.size() - config_.max_blocks;
+  std::nth_element(candidates.begin(), candidates.begin() + (excess - 1), candidates.end(),
+                   first_out);
+  for (std::size_t i = 0; i < excess; ++i) blocks_.erase(candidates[i].key);
+  evicted_to_cap_ += excess;
+  return excess;
 }
 
 void TsdfMap::clear() {

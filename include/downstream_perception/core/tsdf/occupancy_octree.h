@@ -26,7 +26,24 @@ struct OctreeConfig {
   double prob_miss = 0.4;  ///< log-odds -0.405 per pass
   double max_range_m = 10.0;
   int depth_stride_px = 4;  ///< depth images: every n-th pixel in each direction is a ray
+  /// Memory bounds, the OctoMap's counterparts of the TSDF's (applied by maintain()):
+  /// leaves farther than this from the sensor are deleted (0 = never; the TSDF node passes its
+  /// max_block_distance_m); rays are also cut at this range (what lies beyond would go at the
+  /// next maintenance anyway).
+  double max_distance_m = 0.0;
+  /// Cap on memoryBytes() (octomap's count: nodes and child arrays; the heap adds the
+  /// allocator's overhead, about a third more). At the cap maintain() deletes the leaves
+  /// farthest from the sensor until the tree is below 90 % of it (0 = no cap).
+  std::size_t max_memory_bytes = std::size_t{256} << 20;
   std::string validate() const;
+};
+
+/// What one OccupancyOctree::maintain() did, and the tree's size after it.
+struct OctreeMaintenance {
+  std::size_t nodes_evicted_by_distance = 0;  ///< nodes (leaves and inner) deleted
+  std::size_t nodes_evicted_at_cap = 0;
+  std::size_t leaves = 0;
+  std::size_t memory_bytes = 0;
 };
 
 class OccupancyOctree {
@@ -43,6 +60,23 @@ class OccupancyOctree {
   /// A depth image (metres; as integrateDepth) sub-sampled by depth_stride_px.
   void insertDepth(const float* depth, const PinholeCamera& camera,
                    const Eigen::Isometry3d& T_map_camera);
+
+  /// Deletes every leaf whose centre is farther than `distance_m` from `center` (whole subtrees
+  /// at once where they lie entirely beyond it), and the inner nodes left without children;
+  /// the inner nodes on the way keep the maximum of their remaining children. Returns the
+  /// number of nodes deleted.
+  std::size_t evictFartherThan(const Eigen::Vector3d& center, double distance_m);
+  /// Bounds the tree around the sensor at `sensor_origin` (map frame): max_distance_m eviction,
+  /// octomap's prune() (merges 8 equal leaves into their parent), then the max_memory_bytes cap
+  /// (the farthest leaves go first). Walks the tree: tens of ms for a million nodes.
+  OctreeMaintenance maintain(const Eigen::Vector3d& sensor_origin);
+  /// Replaces the memory bounds (max_distance_m, max_memory_bytes; checked as validate()).
+  /// Empty on success, else the reason and nothing changes.
+  std::string setBounds(double max_distance_m, std::size_t max_memory_bytes);
+  /// Nodes in the tree (inner and leaves); constant time, unlike leafCount() and memoryBytes().
+  std::size_t nodeCount() const;
+  /// The octomap tree itself, read-only (tests check its structure).
+  const octomap::OcTree& tree() const { return *tree_; }
 
   /// Log-odds of the leaf containing p, if it was observed.
   bool logOdds(const Eigen::Vector3d& p, double* log_odds) const;

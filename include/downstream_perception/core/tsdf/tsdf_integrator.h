@@ -13,6 +13,14 @@
 
 namespace downstream_perception {
 
+/// validate() bounds: the principal point lies at most this many image sizes outside the image
+/// (cx in [-2 w, 3 w], cy in [-2 h, 3 h]), and every pixel ray at most atan(kMaxViewTangent)
+/// (84 degrees) off the optical axis. Beyond them the view frustum, which carving fills with
+/// blocks up to max_depth_m, grows without bound (cx = 1e7 px made one frame allocate 200,000
+/// blocks).
+constexpr double kMaxPrincipalPointOffset = 2.0;
+constexpr double kMaxViewTangent = 10.0;
+
 /// Pinhole intrinsics of a depth image in the ROS optical convention (z forward, x right,
 /// y down; pixel (u, v) has its centre at integer coordinates, as in CameraInfo's K).
 struct PinholeCamera {
@@ -30,11 +38,17 @@ struct TsdfIntegrationStats {
   std::size_t pixels_valid = 0;      ///< depths (or points) used
   std::size_t pixels_invalid = 0;    ///< NaN, 0, negative or outside [min_depth_m, max_depth_m]
   std::size_t pixels_no_return = 0;  ///< +Inf (REP-118: nothing within range)
+  /// +Inf pixels ignored: carving, in a frame with too few valid depths
+  /// (no_return_carve_min_valid_fraction); also counted in pixels_no_return.
+  std::size_t pixels_no_return_ignored = 0;
   std::size_t blocks_touched = 0;
   std::size_t blocks_allocated = 0;
-  std::size_t blocks_refused = 0;  ///< not allocated: max_blocks reached
+  std::size_t blocks_refused = 0;  ///< not allocated: max_blocks reached (>= 1 if so)
   std::size_t blocks_evicted = 0;  ///< farther than max_block_distance_m
   std::size_t voxels_updated = 0;
+  /// Why the whole frame was refused (all its pixels or points counted invalid), or nullptr:
+  /// invalid intrinsics, a pose or sensor origin not finite or beyond TsdfMap::inBounds.
+  const char* refused = nullptr;
 };
 
 /// Integrates a depth image: `depth` holds width * height depths in metres along the optical

@@ -50,14 +50,26 @@ struct TsdfConfig {
   bool interpolate_depth = true;
   /// Update the voxels along the whole ray from the sensor, not only the truncation band: an
   /// object that moved away is erased where its free space is seen again (voxblox's voxel
-  /// carving; +Inf pixels carve up to max_depth_m). Off by default: it allocates blocks for all
-  /// the free space in view, so memory and time grow with the range.
+  /// carving). Off by default: it allocates blocks for all the free space in view, so memory and
+  /// time grow with the range. Carving stays inside the camera's view frustum up to max_depth_m
+  /// (PinholeCamera::validate refuses intrinsics whose frustum is absurdly wide or off-axis).
   bool carve_free_space = false;
+  /// With carve_free_space, a +Inf pixel ("no return within range", REP 118) carves its ray up to
+  /// max_depth_m only in a frame where at least this fraction of all pixels are valid depths:
+  /// the returns are the evidence that the sensor works and the pose is right. In other frames
+  /// its +Inf pixels are ignored like invalid ones (and counted): one frame without any return
+  /// (a covered or failing sensor) would otherwise carve through every wall in view. 0 = +Inf
+  /// always carves; 1 = only frames without any invalid or +Inf pixel (so +Inf never carves).
+  /// Without carving, +Inf pixels only free voxels of blocks the frame's returns allocate.
+  double no_return_carve_min_valid_fraction = 0.5;
   double min_depth_m = 0.1;   ///< closer depths are invalid
-  double max_depth_m = 10.0;  ///< farther depths are invalid
+  double max_depth_m = 10.0;  ///< farther depths are invalid (at most 1000 m)
   /// Voxels whose weight is below this are "unobserved" for meshing and queries.
   double min_weight = 1e-3;
-  std::size_t max_blocks = 200000;  ///< hard cap: new blocks beyond it are not allocated
+  /// Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig)
+  /// evicts blocks down to the new cap at once: the least recently updated first, among equally
+  /// recent ones the farthest from the last sensor origin.
+  std::size_t max_blocks = 200000;
   /// Blocks whose centre is farther than this from the last sensor origin are evicted after each
   /// integration (0 = never).
   double max_block_distance_m = 0.0;
@@ -102,16 +114,28 @@ class TsdfMap {
 
   const TsdfConfig& config() const { return config_; }
   /// Replaces the settings that do not define the voxel lattice (weights, depth limits,
-  /// edge guard, memory bounds). Empty on success; else the reason, and nothing changes: an
+  /// edge guard, memory bounds; a lower max_blocks evicts at once, see evictToCap). Empty on
+  /// success; else the reason, and nothing changes: an
   /// invalid config, or one with another voxel_size_m or truncation_voxels (those are fixed for
   /// the map's life: the stored distances are in their units).
   std::string setConfig(const TsdfConfig& config);
   double voxelSize() const { return config_.voxel_size_m; }
 
-  /// Block containing voxel `voxel`, and the voxel's index inside it.
+  /// Voxel indices are kept within +-kMaxVoxelIndex on each axis, so that block indices, block
+  /// corners (block * 8) and neighbours (voxel +- 1) are far from int overflow. Points and sensor
+  /// origins are accepted only within half of it (inBounds), which leaves room for the band and
+  /// the rays around them.
+  static constexpr int kMaxVoxelIndex = 1 << 30;
+  /// Whether p (m) is finite and within kMaxVoxelIndex / 2 voxels of the origin on every axis
+  /// (+-5.4e5 km at 1 cm voxels): the integrators refuse points, and frames whose rays reach,
+  /// beyond it (counted as invalid).
+  bool inBounds(const Eigen::Vector3d& p) const;
+
+  /// Block containing voxel `voxel`, and the voxel's index inside it (|voxel| <= kMaxVoxelIndex).
   static Eigen::Vector3i blockOf(const Eigen::Vector3i& voxel);
   static int localIndex(const Eigen::Vector3i& voxel);
-  /// Nearest voxel to a point (m).
+  /// Nearest voxel to a point (m) that is inBounds(); other points (far, NaN) give an index
+  /// clamped to +-kMaxVoxelIndex (NaN: 0), never undefined behaviour: use voxelNear() for them.
   Eigen::Vector3i voxelAt(const Eigen::Vector3d& p) const;
   Eigen::Vector3d voxelCenter(const Eigen::Vector3i& voxel) const {
     return voxel.cast<double>() * config_.voxel_size_m;
@@ -124,6 +148,8 @@ class TsdfMap {
   const TsdfBlock* find(const Eigen::Vector3i& block) const;
   /// The voxel if its block exists, else nullptr.
   const TsdfVoxel* voxel(const Eigen::Vector3i& voxel) const;
+  /// The voxel nearest p (m) if p is inBounds() and its block exists, else nullptr.
+  const TsdfVoxel* voxelNear(const Eigen::Vector3d& p) const;
 
   /// Voxel v after fusing one observation (normalised distance d, weight w). A plain function
   /// of values, so the integrator's loop over a row of voxels vectorises.
@@ -136,6 +162,14 @@ class TsdfMap {
 
   /// Removes blocks whose centre is farther than `distance_m` from `center`; returns how many.
   std::size_t evictFartherThan(const Eigen::Vector3d& center, double distance_m);
+  /// Removes blocks beyond max_blocks (the least recently updated first, ties: the farthest
+  /// from sensorOrigin()); returns how many. setConfig calls it.
+  std::size_t evictToCap();
+  /// Blocks evicted by evictToCap over the map's life (a lowered max_blocks).
+  std::size_t blocksEvictedToCap() const { return evicted_to_cap_; }
+  /// The last sensor origin (map frame) an integration reported; the origin before any.
+  const Eigen::Vector3d& sensorOrigin() const { return sensor_origin_; }
+  void setSensorOrigin(const Eigen::Vector3d& origin) { sensor_origin_ = origin; }
   void clear();
 
   const BlockMap& blocks() const { return blocks_; }
@@ -156,6 +190,8 @@ class TsdfMap {
   std::unique_ptr<TsdfBlockPool> pool_ = std::make_unique<TsdfBlockPool>();
   BlockMap blocks_;
   std::uint64_t generation_ = 0;
+  Eigen::Vector3d sensor_origin_ = Eigen::Vector3d::Zero();
+  std::size_t evicted_to_cap_ = 0;
 };
 
 }  // namespace downstream_perception
