@@ -32,6 +32,20 @@ def test_bresenham_golden_line() -> None:
     assert cells.tolist() == [[2, 2], [3, 3], [4, 3], [5, 4], [6, 4], [7, 5]]
 
 
+def test_extreme_inputs_stay_in_the_grid_or_are_refused() -> None:
+    # Issue 17: a sensor 1e18 m away gave cells outside the grid; extreme ints overflowed.
+    g = dp.GridGeometry(200, 200, 0.05, -5.0, -5.0)
+    for far in (1e12, 1e18, 1e300):
+        for angle in np.linspace(-math.pi, math.pi, 37):
+            cells = dp.ray_cells(g, far * math.cos(angle), far * math.sin(angle), 0.12, -0.3)
+            assert len(cells) > 0
+            assert cells.min() >= 0 and cells.max() < 200
+            assert tuple(cells[-1]) == g.world_to_cell(0.12, -0.3)
+    assert len(dp.ray_cells(g, math.nan, 0.0, 1.0, 1.0)) == 0
+    with pytest.raises(ValueError, match="cells"):
+        dp.bresenham_line(-(2**31), 0, 2**31 - 1, 0)
+
+
 def test_ray_cells_match_a_numpy_supercover_reference() -> None:
     """Every cell the segment crosses, by dense sampling in numpy, equals the C++ walk."""
     rng = np.random.default_rng(5)
