@@ -994,6 +994,11 @@ TEST(Tsdf, FarAndNanPointsAreInvalidNotOverflowed) {
   EXPECT_EQ(map.voxelNear(Eigen::Vector3d(1e300, 0.0, 1.0)), nullptr);
   EXPECT_EQ(map.voxelAt(Eigen::Vector3d(-1e300, nan, 0.02)),
             Eigen::Vector3i(-TsdfMap::kMaxVoxelIndex, 0, 1));
+  // Any index, even INT_MIN, gives its block without overflow.
+  const int lowest = std::numeric_limits<int>::min();
+  EXPECT_EQ(TsdfMap::blockOf(Eigen::Vector3i(lowest, -1, -9)),
+            Eigen::Vector3i(lowest / kTsdfBlockSide, -1, -2));
+  EXPECT_EQ(TsdfMap::localIndex(Eigen::Vector3i(lowest, -1, -9)), TsdfBlock::linear(0, 7, 7));
   EXPECT_FALSE(map.inBounds(Eigen::Vector3d(far, 0.0, 0.0)));
   EXPECT_TRUE(map.inBounds(Eigen::Vector3d(1e6, -1e6, 1e6)));
 }

@@ -64,8 +64,9 @@ std::string TsdfMap::setConfig(const TsdfConfig& config) {
 }
 
 namespace {
+/// floor(a / b) for b > 0, without overflow for any int a (-a overflows at INT_MIN).
 int floorDiv(int a, int b) {
-  return a >= 0 ? a / b : -((-a + b - 1) / b);
+  return a >= 0 ? a / b : -1 - (-(a + 1)) / b;
 }
 
 /// round(x) as an int, clamped to +-TsdfMap::kMaxVoxelIndex (NaN: 0): no float-to-int overflow.
