@@ -55,8 +55,8 @@ void forEachCloudPoint(const sensor_msgs::PointCloud2& msg, std::size_t x_offset
 /// steps over the end of the data. Returns the message itself when already packed.
 sensor_msgs::PointCloud2ConstPtr packedCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
 
-/// A frame, a finite position and a finite unit quaternion (|q| within 1 %: rounding in a
-/// hand-written goal is forgiven, a zero quaternion is not).
+/// A frame, a finite position within 1e8 m and a finite unit quaternion (|q| within 1 %: rounding
+/// in a hand-written goal is forgiven, a zero quaternion is not).
 std::string checkPose(const geometry_msgs::PoseStamped& msg);
 
 }  // namespace downstream_perception

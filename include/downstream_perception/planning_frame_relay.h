@@ -37,6 +37,8 @@ class PlanningFrameRelay {
 
   /// Per input: topic, type, counts and transform-age percentiles (the smear is the caller's).
   std::vector<SeamInput> inputs() const;
+  /// Per input topic: the messages held back for their transform for a while.
+  std::vector<std::pair<std::string, std::vector<TfWait>>> waitingForTf() const;
 
  private:
   struct Input {

@@ -23,6 +23,7 @@
 #include "downstream_perception/TrackerNodeConfig.h"
 #include "downstream_perception/clock_jump.h"
 #include "downstream_perception/core/tracking/tracker.h"
+#include "downstream_perception/filtered_subscription.h"
 #include "downstream_perception/running_stats.h"
 #include "downstream_perception/track_markers.h"
 
@@ -43,7 +44,7 @@ class TrackerRos {
   /// whole message must be dropped.
   bool toCore(const DetectedObjectArray& msg, std::vector<Detection>* out, std::string* why);
   void publish(const std_msgs::Header& header);
-  /// Resets the tracks and tf when the ROS clock went back.
+  /// Resets the tracks and tf when the ROS clock went back; else updates the diagnostics.
   void watchClock(const ros::SteadyTimerEvent&);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void reject(const std::string& reason, const std::string& detail);
@@ -58,8 +59,8 @@ class TrackerRos {
 
   std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  std::unique_ptr<message_filters::Subscriber<DetectedObjectArray>> subscriber_;
-  std::unique_ptr<tf2_ros::MessageFilter<DetectedObjectArray>> filter_;
+  std::unique_ptr<message_filters::Subscriber<DetectedObjectArray>> subscriber_;  ///< image mode
+  FilteredSubscription<DetectedObjectArray> filtered_;  ///< metric mode: released by tf
   ros::Publisher tracks_publisher_;
   ros::Publisher markers_publisher_;
   TrackMarkers markers_;
@@ -73,6 +74,7 @@ class TrackerRos {
   std::size_t frames_ = 0;
   std::map<std::string, std::size_t> rejected_;
   ClockJumpDetector clock_jump_;
+  std::size_t detections_unknown_kind_ = 0;
   ros::SteadyTimer clock_watch_;
   RunningStats step_us_;
   std::vector<std::string> config_errors_;

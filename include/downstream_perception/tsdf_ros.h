@@ -37,6 +37,7 @@
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "downstream_perception/filtered_subscription.h"
 #include "downstream_perception/running_stats.h"
 #include "downstream_perception/save_service.h"
 #include "downstream_perception/tsdf_mesh_markers.h"
@@ -58,9 +59,9 @@ class TsdfRos {
   bool cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why);
   /// A MessageFilter into world_frame_ calling on_ready, and reject() with the reason on a drop.
   template <class M>
-  std::unique_ptr<tf2_ros::MessageFilter<M>> tfFilter(
-      void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&), const std::string& what,
-      std::uint32_t queue);
+  void attachTfFilter(FilteredSubscription<M>* filter,
+                      void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&),
+                      const std::string& what, int queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
   /// Centres of the OctoMap's occupied leaves as a PointCloud2 (x, y, z) for rviz.
@@ -87,9 +88,9 @@ class TsdfRos {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Subscriber camera_info_subscriber_;
   ros::Subscriber depth_subscriber_;
-  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::Image>> depth_filter_;
+  FilteredSubscription<sensor_msgs::Image> depth_filter_;
   ros::Subscriber cloud_subscriber_;
-  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> cloud_filter_;
+  FilteredSubscription<sensor_msgs::PointCloud2> cloud_filter_;
   ros::Publisher mesh_publisher_;
   ros::Publisher slice_publisher_;
   ros::Publisher slice_distance_publisher_;  ///< not advertised when slice_distance_max_m is 0

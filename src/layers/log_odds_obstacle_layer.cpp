@@ -396,6 +396,7 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     config = config_;
   }
   std::size_t rejected_total = 0;
+  std::size_t waiting_total = 0;
   bool all_current = true;
   bool any_integrated = sources_.empty();
   for (auto& source : sources_) {
@@ -429,6 +430,7 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     status.add(p + "points outside height band (total)", h.total.points_outside_height);
     status.add(p + "points merged into a cell's beam (total)", h.total.points_merged);
     status.add(p + "current", current);
+    waiting_total += addTfWaits(status, p, source->waitingForTf());
   }
   status.add("cells occupied", n_occ);
   status.add("cells free", n_free);
@@ -450,6 +452,10 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   if (config_errors_.report(status)) return;  // ERROR, with the first problem
   if (!all_current) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "a source is not current");
+  } else if (waiting_total > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::to_string(waiting_total) +
+                       " message(s) waiting for tf (see 'waiting for tf from ...')");
   } else if (!any_integrated) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no message integrated yet");
   } else if (rejected_total > 0) {

@@ -176,6 +176,7 @@ void TrackInbox::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status,
   status.add(prefix + "transform age mean (s)", transform_age_s_.mean());
   status.add(prefix + "transform age max (s)", transform_age_s_.max);
   status.add(prefix + "track_timeout_s", config_.track_timeout_s);
+  addTfWaits(status, prefix, subscription_.waitingForTf());
 }
 
 }  // namespace downstream_perception

@@ -216,7 +216,10 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
 }
 
 void HandoffRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const auto waits = relay_->waitingForTf();  // before mutex_: the relay has its own locks
   std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t waiting = 0;
+  for (const auto& [topic, w] : waits) waiting += addTfWaits(status, topic + " ", w);
   status.add("planning_frame", planning_frame_);
   status.add("robot_base_frame", robot_base_frame_);
   status.add("yaw rate (rad/s)", health_.yaw_rate_rps);
@@ -239,6 +242,9 @@ void HandoffRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   if (config_errors_.report(status)) return;  // ERROR, with the first problem
   if (!health_.warnings.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, health_.warnings.front());
+  } else if (waiting > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::to_string(waiting) + " message(s) waiting for tf (see 'waiting for tf')");
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "seam healthy");
   }

@@ -123,6 +123,12 @@ std::string checkPose(const geometry_msgs::PoseStamped& msg) {
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
     return "position is not finite";
   }
+  // Beyond any map a robot plans in (UTM and ECEF coordinates stay far below): a garbage goal.
+  constexpr double kMaxCoordinateM = 1e8;
+  if (std::abs(p.x) > kMaxCoordinateM || std::abs(p.y) > kMaxCoordinateM ||
+      std::abs(p.z) > kMaxCoordinateM) {
+    return "position beyond 1e8 m";
+  }
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
   if (!std::isfinite(norm) || std::abs(norm - 1.0) > 0.01) {
     std::ostringstream s;

@@ -158,6 +158,21 @@ void PlanningFrameRelay::onTracks(Input* input, const TrackedObjectArrayConstPtr
   tracks_publisher_.publish(out);
 }
 
+std::vector<std::pair<std::string, std::vector<TfWait>>> PlanningFrameRelay::waitingForTf() const {
+  std::vector<std::pair<std::string, std::vector<TfWait>>> out;
+  for (const auto& input : inputs_) {  // the subscriptions are fixed after construction
+    std::vector<TfWait> waits;
+    const auto append = [&waits](std::vector<TfWait> w) {
+      waits.insert(waits.end(), w.begin(), w.end());
+    };
+    append(input->scans.waitingForTf());  // an input has one of the three
+    append(input->clouds.waitingForTf());
+    append(input->tracks.waitingForTf());
+    out.emplace_back(input->topic, std::move(waits));
+  }
+  return out;
+}
+
 std::vector<SeamInput> PlanningFrameRelay::inputs() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<SeamInput> out;

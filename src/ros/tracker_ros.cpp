@@ -59,14 +59,10 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   } else {
     tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
-    subscriber_ =
-        std::make_unique<message_filters::Subscriber<DetectedObjectArray>>(nh_, "detections", 20);
-    filter_ = std::make_unique<tf2_ros::MessageFilter<DetectedObjectArray>>(
-        *subscriber_, *tf_buffer_, tracking_frame_, static_cast<std::uint32_t>(tf_queue_size), nh_);
-    filter_->registerCallback(
-        boost::bind(&TrackerRos::onDetections, this, boost::placeholders::_1));
-    filter_->registerFailureCallback(boost::bind(&TrackerRos::onTfFailure, this,
-                                                 boost::placeholders::_1, boost::placeholders::_2));
+    filtered_.subscribe(nh_, "detections", *tf_buffer_, tracking_frame_, tf_queue_size,
+                        boost::bind(&TrackerRos::onDetections, this, boost::placeholders::_1),
+                        boost::bind(&TrackerRos::onTfFailure, this, boost::placeholders::_1,
+                                    boost::placeholders::_2));
   }
   // On the steady clock: a jump of the ROS clock must not hold up its own detection.
   clock_watch_ =
@@ -77,8 +73,13 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 void TrackerRos::watchClock(const ros::SteadyTimerEvent&) {
-  if (clock_jump_.check(ros::Time::now(), "tracker") == 0.0) return;
-  if (filter_) filter_->clear();  // messages waiting for old-timeline transforms
+  if (clock_jump_.check(ros::Time::now(), "tracker") == 0.0) {
+    // Diagnostics also while nothing reaches the tracker (all detections waiting for tf, say);
+    // the updater keeps its own period.
+    diagnostics_.update();
+    return;
+  }
+  filtered_.clearWaiting();  // messages waiting for old-timeline transforms
   if (tf_buffer_) restartTf(*tf_buffer_, tf_listener_, nh_);
   {
     // Tracks carry ages and stamps of the old timeline; the new one's frames are older than
@@ -93,7 +94,7 @@ void TrackerRos::watchClock(const ros::SteadyTimerEvent&) {
 TrackerRos::~TrackerRos() {
   clock_watch_.stop();
   reconfigure_server_.reset();
-  filter_.reset();
+  filtered_.unsubscribe();
   subscriber_.reset();
 }
 
@@ -157,6 +158,12 @@ bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* 
   }
   const tf2::Matrix3x3& r = to_tracking.getBasis();
   for (const auto& d : msg.detections) {
+    if (d.kind != DetectedObject::BOX && d.kind != DetectedObject::POSITION) {
+      ++detections_unknown_kind_;  // neither a box nor a position: nothing to read
+      ROS_WARN_THROTTLE(2.0, "tracker: detection of unknown kind %d dropped (BOX=0, POSITION=1)",
+                        static_cast<int>(d.kind));
+      continue;
+    }
     Detection c;
     c.class_id = d.class_id;
     c.score = d.score;
@@ -266,6 +273,8 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("tracks confirmed", last_.confirmed);
   status.add("detections (total)", total_.detections);
   status.add("detections invalid (total)", total_.detections_rejected_invalid);
+  status.add("detections out of range (total)", total_.detections_rejected_out_of_range);
+  status.add("detections of unknown kind (total)", detections_unknown_kind_);
   status.add("detections below low_score (total)", total_.detections_ignored_low_score);
   status.add("detections outside every gate: births (total)", total_.births);
   status.add("matched first pass (total)", total_.matched_first_pass);
@@ -277,8 +286,12 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("step time mean (us)", step_us_.mean());
   status.add("step time max (us)", step_us_.max);
   addConfigErrors(status, config_errors_);
+  const std::size_t waiting = addTfWaits(status, "", filtered_.waitingForTf());
   if (!config_errors_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  } else if (waiting > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::to_string(waiting) + " message(s) waiting for tf (see 'waiting for tf')");
   } else if (frames_ == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no detections received yet");
   } else if (rejected > 0) {

@@ -32,19 +32,17 @@ Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
 }  // namespace
 
 template <class M>
-std::unique_ptr<tf2_ros::MessageFilter<M>> TsdfRos::tfFilter(
-    void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&), const std::string& what,
-    std::uint32_t queue) {
-  auto filter = std::make_unique<tf2_ros::MessageFilter<M>>(*tf_buffer_, world_frame_, queue, nh_);
-  filter->registerCallback(boost::bind(on_ready, this, boost::placeholders::_1));
-  filter->registerFailureCallback(
+void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
+                             void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&),
+                             const std::string& what, int queue) {
+  filter->attach(
+      nh_, *tf_buffer_, world_frame_, queue, boost::bind(on_ready, this, boost::placeholders::_1),
       [this, what](const boost::shared_ptr<const M>& m,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
         std::ostringstream detail;
         detail << what << " in '" << m->header.frame_id << "' at stamp " << m->header.stamp;
         reject(tfFailureReason(reason), detail.str());
       });
-  return filter;
 }
 
 TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
@@ -133,14 +131,13 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
-  const auto queue = static_cast<std::uint32_t>(tf_queue_size);
   camera_info_subscriber_ = nh_.subscribe("depth/camera_info", 5, &TsdfRos::onCameraInfo, this);
   // Raw subscribers check each message first (a wrong encoding is reported at once instead of
   // waiting for tf) and pass it to a tf2 MessageFilter, which holds it until the transform to
   // the world frame at its stamp exists.
-  depth_filter_ = tfFilter<sensor_msgs::Image>(&TsdfRos::onDepth, "depth image", queue);
+  attachTfFilter(&depth_filter_, &TsdfRos::onDepth, "depth image", tf_queue_size);
   depth_subscriber_ = nh_.subscribe("depth/image", 5, &TsdfRos::onDepthRaw, this);
-  cloud_filter_ = tfFilter<sensor_msgs::PointCloud2>(&TsdfRos::onCloud, "point cloud", queue);
+  attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", tf_queue_size);
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
   mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
   reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
@@ -161,8 +158,8 @@ TsdfRos::~TsdfRos() {
   mesh_timer_.stop();
   depth_subscriber_.shutdown();
   cloud_subscriber_.shutdown();
-  depth_filter_.reset();
-  cloud_filter_.reset();
+  depth_filter_.unsubscribe();
+  cloud_filter_.unsubscribe();
 }
 
 void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
@@ -288,7 +285,7 @@ void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
   } else if (!cameraFor(*msg, &camera, &why)) {
     reject("camera_info missing or inconsistent", why);
   } else {
-    depth_filter_->add(msg);
+    depth_filter_.add(msg);
   }
 }
 
@@ -330,7 +327,7 @@ void TsdfRos::onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg) {
     reject("bad point cloud", why);
     return;
   }
-  cloud_filter_->add(msg);
+  cloud_filter_.add(msg);
 }
 
 void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
@@ -531,8 +528,13 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     status.add("health: double crossings within mu (drift or thin objects)",
                health_.double_crossings);
   }
+  const std::size_t waiting = addTfWaits(status, "depth images: ", depth_filter_.waitingForTf()) +
+                              addTfWaits(status, "point clouds: ", cloud_filter_.waitingForTf());
   if (config_errors_.report(status)) return;  // ERROR, with the first problem
-  if (frames_integrated_ == 0) {
+  if (waiting > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::to_string(waiting) + " frame(s) waiting for tf (see 'waiting for tf')");
+  } else if (frames_integrated_ == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame integrated yet");
   } else if (blocks_refused_ > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,

@@ -288,3 +288,13 @@ TEST(CheckScan, RefusesASweepLongerThanTenSeconds) {
   s.time_increment = -2.0f;
   EXPECT_NE(checkScan(s), "");
 }
+
+TEST(CheckPose, RefusesAGoalBeyondAnyMap) {
+  geometry_msgs::PoseStamped p;
+  p.header.frame_id = "map";
+  p.pose.orientation.w = 1.0;
+  p.pose.position.x = 5e5;  // UTM easting: fine
+  EXPECT_EQ(checkPose(p), "");
+  p.pose.position.y = 1e300;
+  EXPECT_NE(checkPose(p), "");
+}

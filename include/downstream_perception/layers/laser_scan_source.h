@@ -17,6 +17,7 @@ class LaserScanSource : public ObservationSource {
 
   void subscribe() override;
   void unsubscribe() override { subscription_.unsubscribe(); }
+  std::vector<TfWait> waitingForTf() const override { return subscription_.waitingForTf(); }
   const char* dataType() const override { return "LaserScan"; }
 
  private:

@@ -50,6 +50,8 @@ class ObservationSource {
   virtual void unsubscribe() = 0;
   /// "LaserScan" or "PointCloud2".
   virtual const char* dataType() const = 0;
+  /// Messages held back for their transform for a while, per frame, with the reason.
+  virtual std::vector<TfWait> waitingForTf() const = 0;
 
   const std::string& name() const { return name_; }
   const ObservationSourceConfig& config() const { return config_; }

@@ -18,6 +18,7 @@ class PointCloudSource : public ObservationSource {
 
   void subscribe() override;
   void unsubscribe() override { subscription_.unsubscribe(); }
+  std::vector<TfWait> waitingForTf() const override { return subscription_.waitingForTf(); }
   const char* dataType() const override { return "PointCloud2"; }
 
  private:
