@@ -452,3 +452,25 @@ TEST(Tracker, OutOfRangeAndNegativeDetectionsAreCountedAndRefused) {
   total.accumulate(s);
   EXPECT_EQ(total.detections_rejected_out_of_range, 6u);
 }
+
+TEST(TrackerConfig, RefusesNoiseAndAgesThatOverflowOrNeverEnd) {
+  TrackerConfig c;
+  EXPECT_EQ(c.validate(), "");
+  c.initial_velocity_std = 1.8e308;  // once a non-finite velocity covariance
+  EXPECT_NE(c.validate(), "");
+  c = TrackerConfig{};
+  c.accel_psd = 1e7;
+  EXPECT_NE(c.validate(), "");
+  c = TrackerConfig{};
+  c.max_age_s = 1e300;  // a coasting track would never die
+  EXPECT_NE(c.validate(), "");
+  c.max_age_s = 3600.0;
+  EXPECT_EQ(c.validate(), "");
+}
+
+TEST(Tracker, RefusesStampsBeyondRosTime) {
+  Tracker tracker(TrackerConfig{});
+  EXPECT_THROW(tracker.step(1e300, {}), std::invalid_argument);
+  EXPECT_THROW(tracker.step(std::nan(""), {}), std::invalid_argument);
+  EXPECT_NO_THROW(tracker.step(1.7e9, {}));
+}

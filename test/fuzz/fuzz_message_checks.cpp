@@ -15,6 +15,7 @@
 #include <ros/time.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2_sensor_msgs/tf2_sensor_msgs.h>
+#include <boost/make_shared.hpp>
 
 #include <cmath>
 #include <cstdint>
@@ -67,7 +68,7 @@ std::string scanConsumers(const sensor_msgs::LaserScan& msg) {
   return {};
 }
 
-/// Whether a PointCloud2 iterator over `field` (the TSDF's and tf2::doTransform's loop: one
+/// Whether a PointCloud2 iterator over `field` (tf2::doTransform's loop: one
 /// point per point_step over the whole data) reads only inside the data. Checks the addresses
 /// the real iterator yields, without reading through them.
 std::string iteratorStaysInside(const sensor_msgs::PointCloud2& msg, const char* field) {
@@ -102,20 +103,30 @@ std::string cloudConsumers(const sensor_msgs::PointCloud2& msg, std::size_t x_of
   dp::ScanIntegrator integrator;
   std::vector<dp::BeamUpdate> beams;
   dp::IntegrationStats stats;
-  for (std::uint32_t row = 0; row < msg.height; ++row) {
+  const std::uint32_t rows = msg.width == 0 ? 0 : msg.height;  // as PointCloudSource::onCloud
+  for (std::uint32_t row = 0; row < rows; ++row) {
     dp::beamsFromCloud(integrator, dp::CloudBeamsConfig{},
                        msg.data.data() + static_cast<std::size_t>(row) * msg.row_step + x_offset,
                        msg.width, msg.point_step, Eigen::Isometry3d::Identity(), &beams, &stats);
   }
-  // The TSDF (PointCloud2ConstIterator) and the relay (tf2::doTransform) iterate per point_step.
+  // The TSDF: forEachCloudPoint through the checked steps.
+  std::uint64_t points = 0;
+  dp::forEachCloudPoint(msg, x_offset, [&points](float, float, float) { ++points; });
+  if (points != static_cast<std::uint64_t>(msg.width) * (msg.width == 0 ? 0 : msg.height)) {
+    return "TSDF: forEachCloudPoint visited " + std::to_string(points) + " points";
+  }
+  // The relay: tf2::doTransform (a PointCloud2 iterator per point_step over the whole data) on
+  // the packed cloud.
+  const sensor_msgs::PointCloud2ConstPtr packed =
+      dp::packedCloud(boost::make_shared<sensor_msgs::PointCloud2>(msg));
   for (const char* field : {"x", "y", "z"}) {
-    const std::string why = iteratorStaysInside(msg, field);
-    if (!why.empty()) return "TSDF / relay: " + why;
+    const std::string why = iteratorStaysInside(*packed, field);
+    if (!why.empty()) return "relay: " + why;
   }
   geometry_msgs::TransformStamped identity;
   identity.transform.rotation.w = 1.0;
   sensor_msgs::PointCloud2 out;
-  tf2::doTransform(msg, out, identity);
+  tf2::doTransform(*packed, out, identity);
   return {};
 }
 

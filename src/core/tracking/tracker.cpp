@@ -11,7 +11,10 @@ namespace downstream_perception {
 
 std::string TrackerConfig::validate() const {
   std::ostringstream why;
-  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  // Noise levels enter covariances squared (and cubed with dt): beyond 1e6 (m, m/s, px or
+  // m^2/s^3) no sensor is meant and the products leave the double range.
+  constexpr double kMaxNoise = 1e6;
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0 && v <= kMaxNoise; };
   if (!(gate_confidence > 0.0 && gate_confidence < 1.0)) {
     why << "gate_confidence must be in (0, 1), got " << gate_confidence;
   } else if (!(duplicate_confidence > 0.0 && duplicate_confidence < 1.0)) {
@@ -21,15 +24,16 @@ std::string TrackerConfig::validate() const {
   } else if (!(min_iou >= 0.0 && min_iou <= 1.0)) {
     why << "min_iou must be in [0, 1], got " << min_iou;
   } else if (!positive(accel_psd)) {
-    why << "accel_psd must be finite and > 0, got " << accel_psd;
+    why << "accel_psd must be in (0, 1e6], got " << accel_psd;
   } else if (!positive(measurement_std)) {
-    why << "measurement_std must be finite and > 0, got " << measurement_std;
+    why << "measurement_std must be in (0, 1e6], got " << measurement_std;
   } else if (!positive(initial_velocity_std)) {
-    why << "initial_velocity_std must be finite and > 0, got " << initial_velocity_std;
+    why << "initial_velocity_std must be in (0, 1e6], got " << initial_velocity_std;
   } else if (min_hits < 1 || min_hits > 1000) {
     why << "min_hits must be in [1, 1000], got " << min_hits;
-  } else if (!(std::isfinite(max_age_s) && max_age_s >= 0.0)) {
-    why << "max_age_s must be finite and >= 0 s, got " << max_age_s;
+  } else if (!(max_age_s >= 0.0 && max_age_s <= kMaxAgeS)) {
+    // Bounded: coasting tracks are memory, and one that never dies keeps a slot forever.
+    why << "max_age_s must be in [0, 3600] s, got " << max_age_s;
   } else if (!(low_score >= 0.0 && low_score <= high_score && high_score <= 1.0)) {
     why << "need 0 <= low_score <= high_score <= 1, got " << low_score << " and " << high_score;
   }
@@ -372,7 +376,10 @@ struct Core : Tracker::Impl {
   }
 
   TrackerStats step(double now, const std::vector<Detection>& detections) override {
-    if (!std::isfinite(now)) throw std::invalid_argument("tracker: stamp must be finite");
+    if (!(std::abs(now) <= TrackerConfig::kMaxStampS)) {
+      throw std::invalid_argument("tracker: stamp must be finite and within 1e10 s, got " +
+                                  std::to_string(now));
+    }
     if (started && now < last_stamp) {
       throw std::invalid_argument("tracker: stamp " + std::to_string(now) +
                                   " s is older than the previous frame's " +

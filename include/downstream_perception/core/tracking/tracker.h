@@ -56,6 +56,10 @@ struct TrackerConfig {
   /// (m^2). Above every earth-fixed frame (UTM northings < 1e7 m, ECEF < 6.4e6 m), far below
   /// where the filter's arithmetic would overflow.
   static constexpr double kMaxPositionM = 1e8;
+  /// Largest max_age_s (s): a coasting track holds memory until it dies.
+  static constexpr double kMaxAgeS = 3600.0;
+  /// Largest |stamp| (s) step() takes: ROS time ends at 2^32 s; beyond, dt^3 overflows.
+  static constexpr double kMaxStampS = 1e10;
 
   enum class Mode { kMetric, kImage };
   Mode mode = Mode::kMetric;
