@@ -6,7 +6,8 @@ Each frame: tf ~world_frame -> ~camera_frame (optical convention) at the frame's
 `depth/camera_info` and `depth/image` (32FC1 metres, NaN = no hit; or 16UC1 millimetres, 0 = no
 hit, with ~encoding: 16UC1). After the last frame, latched std_msgs/Bool(True) on `~done`.
 With ~remove_box_after: n (>= 0), frames n and later render the room without its box: an object
-that moved away, for free-space carving.
+that moved away, for free-space carving. ~blind_frames: [k, ...] are published with every pixel
++Inf (32FC1: no return, as through a covered lens), which carving must not take as free space.
 """
 
 from __future__ import annotations
@@ -65,6 +66,8 @@ def main() -> None:
     without_box = room_scene()
     without_box.boxes = without_box.boxes[1:]  # boxes[0] is the box; the table top stays
     remove_box_after = int(p("~remove_box_after", -1))
+    # Frames seen through a covered lens: every pixel +Inf (no return, REP-118).
+    blind_frames = {int(k) for k in p("~blind_frames", [])}
     poses = circle_poses(frames)
     rng = np.random.default_rng(int(p("~seed", 0)))
     tf = tf2_ros.TransformBroadcaster()
@@ -78,6 +81,8 @@ def main() -> None:
             return
         seen = without_box if 0 <= remove_box_after <= k else scene
         depth = cam.render(seen, T, depth_noise_m=noise, rng=rng)
+        if k in blind_frames:
+            depth = np.full_like(depth, np.inf)
         stamp = rospy.Time.now()
         tf.sendTransform(transform_from_matrix(world, optical, stamp, T))
         header = Header(stamp=stamp, frame_id=optical)

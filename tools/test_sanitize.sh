@@ -63,7 +63,10 @@ module="$(LD_PRELOAD="$preload" "$python" -c \
   echo "sanitize: 0 passed, 1 failed (the sanitized module does not import)"
   exit 1
 }
-if [[ "$module" != "$SAN_WS/devel/"* ]] || ! nm -D "$module" | grep -q __asan_init; then
+# The symbol list into a variable first: `nm | grep -q` under pipefail fails when grep stops
+# reading early (nm gets SIGPIPE).
+symbols="$(nm -D "$module" 2>/dev/null || true)"
+if [[ "$module" != "$SAN_WS/devel/"* ]] || ! grep -q __asan_init <<< "$symbols"; then
   echo "sanitize: 0 passed, 1 failed (python imports $module, not the sanitized module)"
   exit 1
 fi

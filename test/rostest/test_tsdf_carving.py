@@ -71,6 +71,22 @@ class TsdfCarvingTest(unittest.TestCase):
         blocks = {n: int(self.status[n]["blocks"]) for n in ("tsdf_carving", "tsdf_plain")}
         self.assertGreater(blocks["tsdf_carving"], blocks["tsdf_plain"], blocks)
 
+    def test_a_frame_without_any_return_does_not_carve_the_walls(self) -> None:
+        # Frame 20 is +Inf everywhere: no valid depth in it says the sensor saw free space, so its
+        # no-return pixels are ignored (counted) instead of carving through the room to
+        # max_depth_m. Carving it wrecked the map (8.6 % ghosts after 19 more good frames).
+        self.assertTrue(wait_until(lambda: self.done, 60.0), "the simulator did not finish")
+        key = "no-return pixels not carved: too few valid depths in their frame (total)"
+        self.assertTrue(
+            wait_until(lambda: int(self.status.get("tsdf_carving", {}).get(key, 0)) > 0, 10.0),
+            f"diagnostics: {self.status.get('tsdf_carving')}",
+        )
+        self.assertGreaterEqual(int(self.status["tsdf_carving"][key]), 320 * 240)
+        time.sleep(1.5)  # the next mesh update
+        corners = self.carving.corners()
+        error = np.abs(room_scene().signed_distance(corners))
+        self.assertLess(float(np.mean(error > 0.05)), 0.01)  # ghosts: more than a voxel off
+
     def test_slice_distance_cap_off_and_absurd(self) -> None:
         # tsdf_carving: ~slice_distance_max_m 0 turns the clearance topic off (not advertised);
         # tsdf_plain: -1 is refused at start-up, counted as a config error, 2 m used instead.
