@@ -157,6 +157,14 @@ class BadInputTest(unittest.TestCase):
         errors = [v for k, v in layer_values.items() if k.startswith("config error ")]
         self.assertGreaterEqual(int(layer_values["config errors"]), 2)
         self.assertTrue(any("p_hit" in e for e in errors), errors)
+        self.assertTrue(any("far" in e and "1e+15" in e for e in errors), errors)
+        inflation_key = next(
+            k for k in self.status if k.endswith("costmap_absurd: layer inflation")
+        )
+        inflation_level, _, inflation_values = self.status[inflation_key]
+        self.assertEqual(inflation_level, 2, inflation_values)
+        inflation_errors = [v for k, v in inflation_values.items() if k.startswith("config error ")]
+        self.assertTrue(any("inflation_radius" in e for e in inflation_errors), inflation_errors)
 
 
 if __name__ == "__main__":
