@@ -9,8 +9,8 @@ namespace downstream_perception {
 std::string GridGeometry::validate(int size_x, int size_y, double resolution_m, double origin_x_m,
                                    double origin_y_m) {
   std::ostringstream why;
-  if (!std::isfinite(resolution_m) || resolution_m <= 0.0) {
-    why << "resolution must be a finite positive number of metres, got " << resolution_m;
+  if (!(resolution_m > 0.0 && resolution_m <= kMaxResolutionM)) {
+    why << "resolution must be in (0, " << kMaxResolutionM << "] m, got " << resolution_m;
   } else if (size_x <= 0 || size_y <= 0) {
     why << "grid size must be positive, got " << size_x << " x " << size_y << " cells";
   } else if (size_x > kMaxCellsPerAxis || size_y > kMaxCellsPerAxis) {

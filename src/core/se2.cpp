@@ -1,6 +1,10 @@
 #include "downstream_perception/core/se2.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <cmath>
 
 namespace downstream_perception {
 
@@ -37,8 +41,17 @@ Point2 apply(const Pose2D& a, const Point2& p) {
 Pose2D interpolate(const Pose2D& a, double t_a, const Pose2D& b, double t_b, double t) {
   if (t_b == t_a) return a;
   const double alpha = (t - t_a) / (t_b - t_a);
-  return {a.x + alpha * (b.x - a.x), a.y + alpha * (b.y - a.y),
-          normalizeAngle(a.yaw + alpha * shortestAngularDistance(a.yaw, b.yaw))};
+  const Pose2D p{a.x + alpha * (b.x - a.x), a.y + alpha * (b.y - a.y),
+                 normalizeAngle(a.yaw + alpha * shortestAngularDistance(a.yaw, b.yaw))};
+  // Finite poses and stamps can still overflow (a sub-normal interval, an extrapolation 1e300
+  // intervals out): a refusal, not an infinite pose.
+  if (std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(b.x) && std::isfinite(b.y) &&
+      !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.yaw))) {
+    throw std::invalid_argument("interpolate: the pose at t overflows (t = " + std::to_string(t) +
+                                " s between " + std::to_string(t_a) + " and " +
+                                std::to_string(t_b) + " s)");
+  }
+  return p;
 }
 
 }  // namespace downstream_perception

@@ -301,9 +301,11 @@ TEST(PredictedFootprint, OverflowingUncertaintyIsCappedNotZero) {
   // dt^2 * Σv overflows to inf and inf * 0 (the off-diagonal) is NaN: the growth is beyond any
   // cap, so it is the cap (the eigenvalue formula's NaN used to come out as 0).
   PlanarTrack t;
-  t.velocity_covariance << 1.0, 0.0, 0.0, 1.0;
+  t.velocity_covariance << 1e305, 0.0, 0.0, 1e305;
   PredictionConfig c;
   c.max_uncertainty_m = 0.7;
-  EXPECT_DOUBLE_EQ(uncertaintyRadius(t, 1e200, c), 0.7);
+  EXPECT_DOUBLE_EQ(uncertaintyRadius(t, 3600.0, c), 0.7);
+  t.velocity_covariance << 1.0, 0.0, 0.0, 1.0;
   EXPECT_DOUBLE_EQ(uncertaintyRadius(t, 0.1, c), 2.0 * 0.1);  // k sqrt(dt^2 * 1), below the cap
+  EXPECT_THROW(uncertaintyRadius(t, 1e200, c), std::invalid_argument);  // beyond an hour
 }

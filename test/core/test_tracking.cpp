@@ -474,3 +474,25 @@ TEST(Tracker, RefusesStampsBeyondRosTime) {
   EXPECT_THROW(tracker.step(std::nan(""), {}), std::invalid_argument);
   EXPECT_NO_THROW(tracker.step(1.7e9, {}));
 }
+
+TEST(Tracker, ACoastingImageBoxNeverTurnsInsideOut) {
+  // Issue 21's example: a box shrinking 4 px a frame at 25 fps, then nothing: its width kept
+  // shrinking at constant velocity while it coasted, to -0.44 px at frame 26.
+  TrackerConfig c;
+  c.mode = TrackerConfig::Mode::kImage;
+  c.min_hits = 1;
+  Tracker tracker(c);
+  for (int i = 0; i <= 3; ++i) {
+    Detection d;
+    d.box = {100.0, 100.0, 150.0 - 4.0 * i, 250.0};
+    d.score = 0.9;
+    tracker.step(i / 25.0, {d});
+  }
+  for (int i = 4; i <= 40; ++i) {
+    tracker.step(i / 25.0, {});
+    for (const auto& t : tracker.tracks()) {
+      EXPECT_GE(t.size_x, 1.0) << "frame " << i;
+      EXPECT_GE(t.size_y, 1.0) << "frame " << i;
+    }
+  }
+}

@@ -45,6 +45,8 @@ class GridGeometry {
   static constexpr std::size_t kMaxCells = std::size_t{1} << 28;
   /// Per-axis limit: keeps the ray walker's 64-bit fixed-point error term from overflowing.
   static constexpr int kMaxCellsPerAxis = 1 << 22;
+  /// Largest cell (m): beyond it cell centres and extents leave the double range.
+  static constexpr double kMaxResolutionM = 1000.0;
 
   GridGeometry() = default;
   /// Throws std::invalid_argument with a message naming the bad value.

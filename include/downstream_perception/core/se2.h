@@ -28,6 +28,7 @@ Pose2D inverse(const Pose2D& a);
 Point2 apply(const Pose2D& a, const Point2& p);
 /// Pose at time t between (a, t_a) and (b, t_b): linear in translation, shortest arc in yaw.
 /// Extrapolates linearly outside [t_a, t_b]. If t_a == t_b returns a.
+/// Throws std::invalid_argument when finite inputs give a pose that overflows.
 Pose2D interpolate(const Pose2D& a, double t_a, const Pose2D& b, double t_b, double t);
 
 }  // namespace downstream_perception

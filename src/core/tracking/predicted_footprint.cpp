@@ -48,15 +48,36 @@ std::string PlanarTrack::validate() const {
   return {};
 }
 
+namespace {
+
+// Bounds that keep every product below the double range: no object outruns 1e3 m/s, and a
+// prediction (or a look back) an hour out says nothing.
+constexpr double kMaxPredictionTimeS = 3600.0;
+constexpr double kMaxSpeedMps = 1e3;
+constexpr double kMaxPositionM = 1e8;
+
+std::string trackBoundsReason(const PlanarTrack& track) {
+  if (!(track.velocity.norm() <= kMaxSpeedMps)) {
+    return "track speed beyond 1e3 m/s: " + std::to_string(track.velocity.norm());
+  }
+  if (!(track.position.cwiseAbs().maxCoeff() <= kMaxPositionM)) {
+    return "track position beyond 1e8 m";
+  }
+  return {};
+}
+
+}  // namespace
+
 std::string validatePrediction(const PlanarTrack& track, double time_s,
                                const PredictionConfig& config) {
   std::string why = track.validate();
   if (!why.empty()) return "track: " + why;
   why = config.validate();
   if (!why.empty()) return "config: " + why;
-  if (!(std::isfinite(time_s) && time_s >= 0.0)) {
-    return "time must be finite and >= 0 s, got " + std::to_string(time_s);
+  if (!(time_s >= 0.0 && time_s <= kMaxPredictionTimeS)) {
+    return "time must be in [0, 3600] s, got " + std::to_string(time_s);
   }
+  return trackBoundsReason(track);
   return {};
 }
 
@@ -217,10 +238,13 @@ std::string recentCellsReason(const PlanarTrack& track, double lookback_s, doubl
                               double margin_m, double max_object_size_m) {
   const std::string why = track.validate();
   if (!why.empty()) return "track: " + why;
+  const std::string bounds = trackBoundsReason(track);
+  if (!bounds.empty()) return bounds;
   const auto bad = [](double v) { return !(std::isfinite(v) && v >= 0.0); };
   std::ostringstream out;
-  if (bad(lookback_s) || bad(age_s)) {
-    out << "lookback_s and age_s must be finite and >= 0 s, got " << lookback_s << " and " << age_s;
+  if (!(lookback_s >= 0.0 && lookback_s <= kMaxPredictionTimeS && age_s >= 0.0 &&
+        age_s <= kMaxPredictionTimeS)) {
+    out << "lookback_s and age_s must be in [0, 3600] s, got " << lookback_s << " and " << age_s;
   } else if (bad(margin_m) || bad(max_object_size_m)) {
     out << "margin_m and max_object_size_m must be finite and >= 0 m, got " << margin_m << " and "
         << max_object_size_m;

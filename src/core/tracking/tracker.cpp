@@ -59,6 +59,9 @@ void TrackerStats::accumulate(const TrackerStats& o) {
 
 namespace {
 
+/// Smallest width / height (px) a coasting image box keeps (its size has a velocity too).
+constexpr double kMinBoxSizePx = 1.0;
+
 enum class Verdict { kOk, kInvalid, kOutOfRange };
 
 Verdict checkDetection(const Detection& d, TrackerConfig::Mode mode) {
@@ -395,6 +398,10 @@ struct Core : Tracker::Impl {
       s.detection = -1;
       s.filter.predict(dt, processNoise(s));
       if constexpr (D == 2) s.lambda_max = maxEigen(s.filter.positionCov());
+      if constexpr (D == 4) {  // image boxes: width and height stay positive while coasting
+        s.filter.clampPositionBelow(2, kMinBoxSizePx);
+        s.filter.clampPositionBelow(3, kMinBoxSizePx);
+      }
     }
 
     // Split detections by score; measurements once per detection.

@@ -17,8 +17,9 @@ std::string OctreeConfig::validate() const {
   } else if (!(prob_hit > 0.5 && prob_hit < 1.0 && prob_miss > 0.0 && prob_miss < 0.5)) {
     why << "need 0.5 < prob_hit < 1 and 0 < prob_miss < 0.5, got " << prob_hit << " and "
         << prob_miss;
-  } else if (!(std::isfinite(max_range_m) && max_range_m > 0.0)) {
-    why << "max_range_m must be finite and > 0, got " << max_range_m;
+  } else if (!(max_range_m > 0.0 && max_range_m <= 1000.0)) {
+    // Beyond every depth sensor; a 1e300 m ray never finished casting.
+    why << "max_range_m must be in (0, 1000] m, got " << max_range_m;
   } else if (depth_stride_px < 1 || depth_stride_px > 64) {
     why << "depth_stride_px must be in [1, 64], got " << depth_stride_px;
   } else if (!(std::isfinite(max_distance_m) && max_distance_m >= 0.0)) {

@@ -2,6 +2,8 @@
 // image box's centre and size). State [p, v] (2D), white-noise acceleration process model.
 #pragma once
 
+#include <algorithm>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
@@ -80,6 +82,13 @@ class ConstantVelocityKalman {
   Mat positionCov() const { return P_.template topLeftCorner<D, D>(); }
   Mat velocityCov() const { return P_.template bottomRightCorner<D, D>(); }
   const State& state() const { return x_; }
+  /// Keeps position axis k at least `floor`: a state below it is raised to it and its velocity
+  /// along k stops falling (a coasting box that shrinks must not turn inside out).
+  void clampPositionBelow(int k, double floor) {
+    if (!(x_(k) < floor)) return;
+    x_(k) = floor;
+    x_(D + k) = std::max(0.0, x_(D + k));
+  }
   const Cov& covariance() const { return P_; }
 
  private:
