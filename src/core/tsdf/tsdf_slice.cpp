@@ -92,8 +92,8 @@ std::vector<float> sliceDistance(const std::vector<SliceCell>& cells, const Grid
     throw std::invalid_argument("slice distance: " + std::to_string(cells.size()) +
                                 " cells for a grid of " + std::to_string(n));
   }
-  if (!(std::isfinite(max_distance_m) && max_distance_m >= 0.0)) {
-    throw std::invalid_argument("slice distance: max_distance_m must be finite and >= 0, got " +
+  if (!(max_distance_m >= 0.0 && max_distance_m <= 1e6)) {  // distances are float32
+    throw std::invalid_argument("slice distance: max_distance_m must be in [0, 1e6] m, got " +
                                 std::to_string(max_distance_m));
   }
   std::vector<float> distance(n, std::numeric_limits<float>::quiet_NaN());

@@ -42,8 +42,8 @@ std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
 /// a separable distance transform over squared cell distances), 0 on occupied cells, capped at
 /// max_distance_m, NaN on unknown cells (the distance does not see through them: it treats
 /// them as free). For planners that want clearance rather than a binary obstacle map. Throws
-/// std::invalid_argument when `cells` does not match `grid` or max_distance_m is not finite and
-/// >= 0.
+/// std::invalid_argument when `cells` does not match `grid` or max_distance_m is outside
+/// [0, 1e6] m (the distances are float32: a larger cap would come out as +Inf).
 std::vector<float> sliceDistance(const std::vector<SliceCell>& cells, const GridGeometry& grid,
                                  double max_distance_m);
 
