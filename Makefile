@@ -6,16 +6,21 @@
 #   make test-sanitize   ASan+UBSan build (.ws-san) running the gtests and the pytests
 #   make fuzz            fixed-seed fuzz campaign (FUZZ_CASES=20000 by default, FUZZ_SEED=17)
 #   make fuzz-sanitize   the binding part of that campaign against the sanitized module
+# Soaks (README "Benchmarks"):
+#   make soak            10-minute soaks of the costmap and TSDF nodelets (SOAK_MINUTES=10,
+#                        SOAK_ONLY=costmap|tsdf): RSS and messages handled, out/soak.md
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d lint clean
+.PHONY: help deps build test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d soak lint clean
 
 FUZZ_CASES ?= 20000
 FUZZ_SEED ?= 17
+SOAK_MINUTES ?= 10
+SOAK_ONLY ?=
 
 help:
-	@echo "make demo | make test | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make soak | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -51,6 +56,10 @@ bench-open3d: build
 	@tools/open3d_venv.sh
 	@source tools/env.sh && source_workspace && OMP_NUM_THREADS=1 \
 		"$$WS/open3d-venv/bin/python" scripts/bench_open3d.py
+
+soak: build
+	@source tools/env.sh && source_workspace && python3 scripts/soak.py --out out \
+		--minutes $(SOAK_MINUTES) $(if $(SOAK_ONLY),--only $(SOAK_ONLY))
 
 lint:
 	@tools/lint.sh

@@ -8,9 +8,15 @@ hit, with ~encoding: 16UC1). After the last frame, latched std_msgs/Bool(True) o
 With ~remove_box_after: n (>= 0), frames n and later render the room without its box: an object
 that moved away, for free-space carving. ~blind_frames: [k, ...] are published with every pixel
 +Inf (32FC1: no return, as through a covered lens), which carving must not take as free space.
+With ~trajectory: corridor the camera walks down an endless corridor instead (sim.depth_camera.
+corridor_scene, ~speed_mps, default 1 m/s, for ~frames frames: a long path for soaks of the
+distance eviction); the corridor repeats every 4 m, so one period is rendered before the first
+frame and replayed shifted (~depth_noise_m is then added per frame; ~remove_box_after is ignored).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 import rospy
@@ -19,7 +25,14 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Bool, Header
 
 from downstream_perception.ros_util import transform_from_matrix
-from downstream_perception.sim.depth_camera import DepthCamera, circle_poses, room_scene
+from downstream_perception.sim.depth_camera import (
+    CORRIDOR_PERIOD_M,
+    DepthCamera,
+    circle_poses,
+    corridor_poses,
+    corridor_scene,
+    room_scene,
+)
 
 
 def camera_info(cam: DepthCamera, header: Header) -> CameraInfo:
@@ -49,6 +62,51 @@ def depth_image(depth: np.ndarray, header: Header, encoding: str) -> Image:
     return msg
 
 
+Frame = tuple[np.ndarray, np.ndarray]  # (depth image, T_world_camera)
+
+
+def room_frames(
+    cam: DepthCamera, frames: int, remove_box_after: int, noise: float, rng: np.random.Generator
+) -> Callable[[int], Frame]:
+    """Frame k of `frames` on the circle around the room, rendered when asked for."""
+    scene = room_scene()
+    without_box = room_scene()
+    without_box.boxes = without_box.boxes[1:]  # boxes[0] is the box; the table top stays
+    poses = circle_poses(frames)
+
+    def frame(k: int) -> Frame:
+        seen = without_box if 0 <= remove_box_after <= k else scene
+        return cam.render(seen, poses[k], depth_noise_m=noise, rng=rng), poses[k]
+
+    return frame
+
+
+def corridor_frames(
+    cam: DepthCamera, speed_mps: float, rate_hz: float, noise: float, rng: np.random.Generator
+) -> Callable[[int], Frame]:
+    """Frame k walking down the corridor at speed_mps: one period rendered now, then replayed
+    shifted by whole periods (the corridor repeats, so the images are those of the endless
+    corridor)."""
+    if not np.isfinite(speed_mps) or speed_mps <= 0.0:
+        rospy.logerr("depth_sim: ~speed_mps must be positive, got %s; using 1.0", speed_mps)
+        speed_mps = 1.0
+    n = max(1, round(CORRIDOR_PERIOD_M * rate_hz / speed_mps))
+    poses = corridor_poses(n)
+    scene = corridor_scene()
+    rospy.loginfo("depth_sim: rendering the corridor's %d frames per %.0f m", n, CORRIDOR_PERIOD_M)
+    depths = [cam.render(scene, T) for T in poses]
+
+    def frame(k: int) -> Frame:
+        T = poses[k % n].copy()
+        T[0, 3] += (k // n) * CORRIDOR_PERIOD_M
+        depth = depths[k % n]
+        if noise > 0.0:
+            depth = (depth + rng.normal(0.0, noise, depth.shape)).astype(np.float32)
+        return depth, T
+
+    return frame
+
+
 def main() -> None:
     rospy.init_node("depth_sim")
     p = rospy.get_param
@@ -62,25 +120,27 @@ def main() -> None:
     if encoding not in ("32FC1", "16UC1"):
         rospy.logerr("depth_sim: ~encoding must be 32FC1 or 16UC1; using 32FC1")
         encoding = "32FC1"
-    scene = room_scene()
-    without_box = room_scene()
-    without_box.boxes = without_box.boxes[1:]  # boxes[0] is the box; the table top stays
-    remove_box_after = int(p("~remove_box_after", -1))
+    trajectory = str(p("~trajectory", "circle"))
+    if trajectory not in ("circle", "corridor"):
+        rospy.logerr("depth_sim: ~trajectory must be circle or corridor; using circle")
+        trajectory = "circle"
     # Frames seen through a covered lens: every pixel +Inf (no return, REP-118).
     blind_frames = {int(k) for k in p("~blind_frames", [])}
-    poses = circle_poses(frames)
     rng = np.random.default_rng(int(p("~seed", 0)))
+    if trajectory == "corridor":
+        frame_at = corridor_frames(cam, float(p("~speed_mps", 1.0)), rate_hz, noise, rng)
+    else:
+        frame_at = room_frames(cam, frames, int(p("~remove_box_after", -1)), noise, rng)
     tf = tf2_ros.TransformBroadcaster()
     info_pub = rospy.Publisher("depth/camera_info", CameraInfo, queue_size=5)
     image_pub = rospy.Publisher("depth/image", Image, queue_size=5)
     done = rospy.Publisher("~done", Bool, queue_size=1, latch=True)
     rospy.sleep(float(p("~start_delay_s", 2.0)))  # let subscribers connect
     rate = rospy.Rate(rate_hz)
-    for k, T in enumerate(poses):
+    for k in range(frames):
         if rospy.is_shutdown():
             return
-        seen = without_box if 0 <= remove_box_after <= k else scene
-        depth = cam.render(seen, T, depth_noise_m=noise, rng=rng)
+        depth, T = frame_at(k)
         if k in blind_frames:
             depth = np.full_like(depth, np.inf)
         stamp = rospy.Time.now()

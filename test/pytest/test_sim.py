@@ -19,6 +19,12 @@ from downstream_perception.sim import (
     warehouse_aisle,
 )
 from downstream_perception.sim import world as w
+from downstream_perception.sim.depth_camera import (
+    CORRIDOR_PERIOD_M,
+    DepthCamera,
+    corridor_poses,
+    corridor_scene,
+)
 
 
 def cast(world: World, origin: tuple[float, float], angle_deg: float, t: float = 0.0) -> float:
@@ -157,3 +163,39 @@ def test_moving_box_is_hit_where_it_is_and_reported_with_its_size() -> None:
     assert stand(2.0, 0.0, 10.0).pose(5.0) == pytest.approx((2.0, 0.0, 0.0))
     with pytest.raises(ValueError):
         stand(2.0, 0.0, 0.0)
+
+
+def small_camera() -> DepthCamera:
+    """A quarter of the QVGA camera (same field of view): quick renders."""
+    return DepthCamera(80, 60, 65.625, 65.625, 39.5, 29.5)
+
+
+def test_corridor_shows_what_an_endless_corridor_shows() -> None:
+    cam = small_camera()
+    poses = corridor_poses(12)
+    scene = corridor_scene()  # the copies it keeps
+    endless = corridor_scene(copies=range(-10, 14))  # as good as endless within 10 m
+    shifted = corridor_scene(copies=range(0, 6))  # the kept copies one period further on
+    for T in poses:
+        depth = cam.render(scene, T)
+        np.testing.assert_array_equal(depth, cam.render(endless, T))
+        # One period further down the corridor the camera sees the same image: the simulator
+        # replays one rendered period.
+        ahead = T.copy()
+        ahead[0, 3] += CORRIDOR_PERIOD_M
+        np.testing.assert_allclose(cam.render(shifted, ahead), depth, rtol=0, atol=1e-5)
+        assert np.isfinite(depth).mean() > 0.9  # floor, walls and furniture within range
+
+
+def test_corridor_poses_walk_ahead_one_period() -> None:
+    poses = corridor_poses(20)
+    x = np.array([T[0, 3] for T in poses])
+    np.testing.assert_allclose(np.diff(x), CORRIDOR_PERIOD_M / 20)
+    assert x[0] == 0.0 and x[-1] + CORRIDOR_PERIOD_M / 20 == pytest.approx(CORRIDOR_PERIOD_M)
+    for T in poses:
+        np.testing.assert_allclose(T[1:3, 3], [0.0, 1.5])
+        forward = T[:3, 2]  # the optical axis
+        assert forward[0] > 0.5 and forward[2] < 0.0  # ahead and down, never behind
+        np.testing.assert_allclose(T[:3, :3].T @ T[:3, :3], np.eye(3), atol=1e-12)
+    with pytest.raises(ValueError):
+        corridor_poses(0)

@@ -127,6 +127,57 @@ def room_scene(offset: tuple[float, float, float] = (0.0073, -0.0041, 0.0029)) -
     )
 
 
+CORRIDOR_PERIOD_M = 4.0  # the corridor repeats the room's furniture every 4 m along x
+
+
+def corridor_scene(
+    copies: range = range(-1, 5), period_m: float = CORRIDOR_PERIOD_M, length_m: float = 1000.0
+) -> Scene3D:
+    """An endless corridor for long camera paths (soaks): the room's cross-section (y, z) open
+    along x to +-length_m, its furniture repeated every `period_m` (copy k shifted by k *
+    period_m). Seen from x in [0, period_m) looking ahead (+x, within 90 degrees) with a 10 m
+    range, copies -1 .. 4 are all an endless corridor would show: the others are out of range or
+    behind the camera. So a frame seen from x + period_m equals the one seen from x, and a
+    simulator can render one period and replay it shifted."""
+    room = room_scene()
+    lo, hi = room.room_min, room.room_max
+    scene = Scene3D(room_min=(-length_m, lo[1], lo[2]), room_max=(length_m, hi[1], hi[2]))
+    for k in copies:
+        dx = k * period_m
+        scene.boxes += [
+            Box((b.center[0] + dx, b.center[1], b.center[2]), b.half_extents) for b in room.boxes
+        ]
+        scene.spheres += [
+            Sphere((s.center[0] + dx, s.center[1], s.center[2]), s.radius) for s in room.spheres
+        ]
+        scene.cylinders += [
+            Cylinder((c.center_xy[0] + dx, c.center_xy[1]), c.radius, c.z_min, c.z_max)
+            for c in room.cylinders
+        ]
+    return scene
+
+
+def corridor_poses(
+    n: int,
+    period_m: float = CORRIDOR_PERIOD_M,
+    height_m: float = 1.5,
+    sway_rad: float = 0.5,
+) -> list[np.ndarray]:
+    """n camera poses walking one period down the corridor's middle (y = 0): x = k * period_m /
+    n, looking ahead and down at the furniture, yaw swaying +-sway_rad once per period. Pose k +
+    n is pose k shifted by period_m along x (see corridor_scene)."""
+    if n < 1 or not period_m > 0.0 or not abs(sway_rad) < 1.2:
+        raise ValueError("corridor_poses: n >= 1, period_m > 0 and |sway_rad| < 1.2 rad")
+    poses = []
+    for k in range(n):
+        x = k * period_m / n
+        yaw = sway_rad * np.sin(2.0 * np.pi * k / n)
+        eye = np.array([x, 0.0, height_m])
+        target = eye + np.array([2.0 * np.cos(yaw), 2.0 * np.sin(yaw), -0.9])
+        poses.append(look_at(eye, target))
+    return poses
+
+
 @dataclass
 class DepthCamera:
     width: int = 320
