@@ -28,8 +28,12 @@ class Layer {
  public:
   virtual ~Layer() = default;
 
+  /// `host_nh`: the host node's own namespace, where relative topics resolve (costmap_2d's
+  /// layers subscribe through the node's global NodeHandle: `topic: scan` of a costmap in
+  /// move_base is /scan, not /move_base/local_costmap/obstacles/scan).
   void initialize(LayeredCostmap* parent, const std::string& name, tf2_ros::Buffer* tf,
-                  const ros::NodeHandle& host_private_nh);
+                  const ros::NodeHandle& host_private_nh,
+                  const ros::NodeHandle& host_nh = ros::NodeHandle());
 
   /// World-metre box that this layer needs redrawn; only grow the box.
   virtual void updateBounds(double robot_x, double robot_y, double robot_yaw, double* min_x,
@@ -71,7 +75,8 @@ class Layer {
   LayeredCostmap* layered_costmap_ = nullptr;
   std::string name_;
   tf2_ros::Buffer* tf_ = nullptr;
-  ros::NodeHandle nh_;  ///< the layer's parameter namespace: <host private ns>/<name>
+  ros::NodeHandle nh_;        ///< the layer's parameter namespace: <host private ns>/<name>
+  ros::NodeHandle topic_nh_;  ///< the host node's namespace: sensor topics resolve here
   bool current_ = true;
   bool enabled_ = true;
 };

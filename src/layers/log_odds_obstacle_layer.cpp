@@ -131,6 +131,32 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
       enabled_ ? "enabled" : "disabled");
 }
 
+std::string LogOddsObstacleLayer::readCostmap2dRanges(const ros::NodeHandle& source_nh,
+                                                      const std::string& source,
+                                                      ScanIntegratorConfig* ic) {
+  // costmap_2d's obstacle_range / raytrace_range: the maximum marking / clearing range, looked
+  // up like costmap_2d does (searchParam from the source's namespace up: source, layer,
+  // costmap, ...). Our *_max_range keys at the source, when given, win (and a conflict is named).
+  std::string from;
+  const auto take = [&](const char* theirs, const char* ours, double* value) {
+    std::string key;
+    double v = 0.0;
+    if (!source_nh.searchParam(theirs, key) || !source_nh.getParam(key, v)) return;
+    if (source_nh.hasParam(ours)) {
+      if (v != *value) {
+        ROS_WARN("layer '%s', source '%s': both %s (%s = %.3f) and %s (%.3f) are set; using %s",
+                 name_.c_str(), source.c_str(), theirs, key.c_str(), v, ours, *value, ours);
+      }
+      return;
+    }
+    *value = v;
+    from += std::string(from.empty() ? "; " : ", ") + theirs + " from " + key;
+  };
+  take("obstacle_range", "obstacle_max_range", &ic->obstacle_max_range);
+  take("raytrace_range", "raytrace_max_range", &ic->raytrace_max_range);
+  return from;
+}
+
 void LogOddsObstacleLayer::readSources() {
   std::string names;
   nh_.param("observation_sources", names, std::string());
@@ -163,6 +189,7 @@ void LogOddsObstacleLayer::readSources() {
     snh.param("obstacle_max_range", ic.obstacle_max_range, d.obstacle_max_range);
     snh.param("raytrace_min_range", ic.raytrace_min_range, d.raytrace_min_range);
     snh.param("raytrace_max_range", ic.raytrace_max_range, d.raytrace_max_range);
+    const std::string ranges_from = readCostmap2dRanges(snh, name, &ic);
     snh.param("inf_is_valid", ic.inf_is_valid, d.inf_is_valid);
     snh.param("range_max_is_no_return", ic.range_max_is_no_return, d.range_max_is_no_return);
     // One beam per grid cell of a cloud: the same cells, a fraction of the ray walks.
@@ -181,15 +208,15 @@ void LogOddsObstacleLayer::readSources() {
     };
     if (data_type == "LaserScan") {
       sources_.push_back(std::make_unique<LaserScanSource>(
-          name, config, nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
+          name, config, topic_nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
     } else {
       sources_.push_back(std::make_unique<PointCloudSource>(
-          name, config, nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
+          name, config, topic_nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
     }
-    ROS_INFO("layer '%s': %s source '%s' on %s (mark <= %.2f m, clear <= %.2f m%s)", name_.c_str(),
-             data_type.c_str(), name.c_str(),
-             ros::names::resolve(nh_.getNamespace(), config.topic).c_str(), ic.obstacle_max_range,
-             ic.raytrace_max_range,
+    ROS_INFO("layer '%s': %s source '%s' on %s (mark <= %.2f m, clear <= %.2f m%s%s)",
+             name_.c_str(), data_type.c_str(), name.c_str(),
+             ros::names::resolve(topic_nh_.getNamespace(), config.topic).c_str(),
+             ic.obstacle_max_range, ic.raytrace_max_range, ranges_from.c_str(),
              data_type == "PointCloud2"
                  ? (", heights [" + std::to_string(config.cloud.min_obstacle_height) + ", " +
                     std::to_string(config.cloud.max_obstacle_height) + "] m")

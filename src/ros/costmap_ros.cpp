@@ -168,7 +168,7 @@ void CostmapRos::loadPlugins() {
     try {
       std::shared_ptr<Layer> layer = plugin_loader_->createSharedInstance(type);
       layered_costmap_->addPlugin(layer);
-      layer->initialize(layered_costmap_.get(), name, tf_buffer_.get(), pnh_);
+      layer->initialize(layered_costmap_.get(), name, tf_buffer_.get(), pnh_, nh_);
       layer->matchSize();
       diagnostics_.add("layer " + name, [layer](diagnostic_updater::DiagnosticStatusWrapper& s) {
         layer->diagnose(s);

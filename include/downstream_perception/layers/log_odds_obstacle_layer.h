@@ -58,6 +58,10 @@ class LogOddsObstacleLayer : public Layer {
   using ReconfigureServer = dynamic_reconfigure::Server<LogOddsObstacleLayerConfig>;
   void reconfigure(LogOddsObstacleLayerConfig& config, std::uint32_t level);
   void readSources();
+  /// costmap_2d's obstacle_range / raytrace_range into *ic (unless ours are set at the source);
+  /// returns "; obstacle_range from <key>..." for the start-up line, or "".
+  std::string readCostmap2dRanges(const ros::NodeHandle& source_nh, const std::string& source,
+                                  ScanIntegratorConfig* ic);
   void integrate(ObservationSource& source, const Observation& observation);
   void markAllDirty();
   void clearFootprint(double robot_x, double robot_y, double robot_yaw);
