@@ -244,6 +244,40 @@ def rss_kb(pid: int) -> int:
     raise RuntimeError(f"no VmRSS for pid {pid}")
 
 
+def smaps_breakdown(smaps: str) -> dict[str, float]:
+    """RSS by kind of mapping (MB) from /proc/<pid>/smaps: the main heap; glibc's other malloc
+    arenas (one per thread that allocates: anonymous mappings at 64 MiB-aligned addresses); other
+    anonymous mappings (big allocations, the TSDF's 2 MiB chunks, stacks of threads); files
+    (libraries); how much of all anonymous memory sits in transparent huge pages."""
+    kb = {"heap": 0, "malloc arenas": 0, "anonymous": 0, "huge pages": 0, "files": 0, "other": 0}
+    kind = "other"
+    for line in smaps.splitlines():
+        fields = line.split()
+        if not fields:
+            continue
+        if "-" in fields[0] and not fields[0].endswith(":"):  # a mapping's header line
+            path = fields[5] if len(fields) > 5 else ""
+            start = int(fields[0].split("-")[0], 16)
+            if path == "[heap]":
+                kind = "heap"
+            elif not path:
+                kind = "malloc arenas" if start % (64 << 20) == 0 else "anonymous"
+            else:
+                kind = "files" if path.startswith("/") else "other"
+        elif fields[0] == "Rss:":
+            kb[kind] += int(fields[1])
+        elif fields[0] == "AnonHugePages:":
+            kb["huge pages"] += int(fields[1])
+    return {f"RSS {k} (MB)": v / 1024.0 for k, v in kb.items()}
+
+
+def rss_figures(pid: int) -> dict[str, float]:
+    try:
+        return smaps_breakdown(Path(f"/proc/{pid}/smaps").read_text())
+    except OSError:
+        return {}
+
+
 class Processes:
     """What this script started, each in a session of its own (so a Ctrl-C reaches this script
     only, and stop() ends each group: roslaunch and its nodes)."""
@@ -353,7 +387,9 @@ def sample_loop(
         t = time.time() - t0
         if t >= next_sample or t >= 60.0 * minutes:
             try:
-                samples.append(Sample(t, rss_kb(pid), handled(), figures()))
+                f = figures()
+                f.update(rss_figures(pid))
+                samples.append(Sample(t, rss_kb(pid), handled(), f))
             except (FileNotFoundError, ProcessLookupError):
                 notes.append(f"the manager (pid {pid}) died at {t:.0f} s")
                 break
@@ -600,6 +636,7 @@ def tsdf_soak(procs: Processes, port: int, out: Path, minutes: float) -> SoakRes
         "TSDF memory (MB)": "memory (MB)",
         "blocks evicted by distance": "blocks evicted by distance (total)",
         "integration mean (ms)": "integration time mean (ms)",
+        "mesh triangles": "mesh triangles",
         "OctoMap observations inserted": "octomap: observations inserted",
         "OctoMap observations dropped": "octomap: observations dropped (queue full: insertion "
         "slower than the sensor)",

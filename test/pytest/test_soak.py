@@ -122,3 +122,34 @@ def test_csv_has_every_sample_and_figure(soak: Any, tmp_path: Path) -> None:
     assert lines[0] == "t_s,rss_kb,handled,OctoMap leaves,blocks"
     assert lines[1] == "0.0,1000,0,,100.0"
     assert lines[2] == "5.0,1001,75,7.0,105.0"
+
+
+SMAPS = """\
+55d0c0a00000-55d0c0b00000 rw-p 00000000 00:00 0                          [heap]
+Rss:                2048 kB
+AnonHugePages:         0 kB
+7f0000000000-7f0000400000 rw-p 00000000 00:00 0
+Size:               4096 kB
+Rss:                3072 kB
+AnonHugePages:      2048 kB
+7f0000400000-7f0004000000 ---p 00000000 00:00 0
+Rss:                   0 kB
+7f0008200000-7f0008400000 rw-p 00000000 00:00 0
+Rss:                1024 kB
+AnonHugePages:      1024 kB
+7f1000000000-7f1000100000 r-xp 00000000 08:01 1234                       /usr/lib/libx.so
+Rss:                 512 kB
+AnonHugePages:         0 kB
+7ffd00000000-7ffd00021000 rw-p 00000000 00:00 0                          [stack]
+Rss:                 128 kB
+"""
+
+
+def test_smaps_breakdown_sums_rss_by_kind_of_mapping(soak: Any) -> None:
+    b = soak.smaps_breakdown(SMAPS)
+    assert b["RSS heap (MB)"] == 2.0
+    assert b["RSS malloc arenas (MB)"] == 3.0  # unnamed, at a 64 MiB-aligned address
+    assert b["RSS anonymous (MB)"] == 1.0  # unnamed elsewhere
+    assert b["RSS huge pages (MB)"] == 3.0  # of both, in transparent huge pages
+    assert b["RSS files (MB)"] == 0.5
+    assert b["RSS other (MB)"] == 0.125  # the stack
