@@ -51,6 +51,13 @@ def test_growth_after_the_first_minute_uses_the_sample_at_one_minute(soak: Any) 
         soak.sample_at([], 0.0)
 
 
+def test_trend_is_the_slope_after_the_first_minute(soak: Any) -> None:
+    # Start-up (0 -> 60 s) is left out; then 1 MB per minute, minutes 2 and 3 0.5 MB above the line.
+    rss = [(0.0, 1024), (60.0, 10_240), (120.0, 11_776), (180.0, 12_800), (240.0, 13_312)]
+    assert soak.trend_mb_per_min(result(soak, rss).samples) == pytest.approx(1.0)
+    assert math.isnan(soak.trend_mb_per_min(result(soak, rss[:2]).samples))
+
+
 def test_rate_between_samples(soak: Any) -> None:
     a = soak.Sample(10.0, 1, handled=100, figures={"scans sent": 110.0})
     b = soak.Sample(20.0, 1, handled=1100, figures={"scans sent": 1210.0})
@@ -100,8 +107,9 @@ def test_table_and_closing_line(soak: Any) -> None:
     flat.notes = ["held 10 Hz"]
     text = "\n".join(soak.markdown([flat, grows], "1.00, 1.00, 1.00"))
     rows = {line.split(" | ")[0]: line for line in text.splitlines() if line.startswith("| ")}
-    assert rows["| tsdf"].endswith("| 10.0 | 20.0 | 22.0 | +10.00 % | NO |")
-    assert rows["| costmap"].endswith("| 10.0 | 20.0 | 20.0 | +0.00 % | yes |")
+    # 20 -> 22 MB from minute 1 to 10: +10 %, 2/9 MB per minute.
+    assert rows["| tsdf"].endswith("| 10.0 | 20.0 | 22.0 | +10.00 % | NO | +0.222 |")
+    assert rows["| costmap"].endswith("| 10.0 | 20.0 | 20.0 | +0.00 % | yes | +0.000 |")
     assert "9,000 frames integrated" in rows["| tsdf"]
     assert "| blocks | 100 | 160 | 700 |" in text  # diagnostics at start, 1 min, end
     assert "| 10 | 10 | nan | nan | nan | yes |" in text  # the ramp's step
