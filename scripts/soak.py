@@ -83,6 +83,20 @@ def growth_pct(before_kb: float, after_kb: float) -> float:
     return 100.0 * (after_kb - before_kb) / before_kb
 
 
+def trend_mb_per_min(samples: Sequence[Sample], after_s: float = 60.0) -> float:
+    """Least-squares slope of RSS (MB per minute) over the samples from after_s on: the growth
+    that goes on, less sensitive than the end point to malloc's swings (NaN with < 2 samples)."""
+    pts = [(s.t_s / 60.0, s.rss_kb / 1024.0) for s in samples if s.t_s >= after_s]
+    if len(pts) < 2:
+        return math.nan
+    mt = sum(t for t, _ in pts) / len(pts)
+    mr = sum(r for _, r in pts) / len(pts)
+    var = sum((t - mt) ** 2 for t, _ in pts)
+    if var == 0:
+        return math.nan
+    return sum((t - mt) * (r - mr) for t, r in pts) / var
+
+
 def rate_between(a: Sample, b: Sample, figure: str | None = None) -> float:
     """Messages handled (or a figure that counts) per second from sample a to sample b."""
     if not b.t_s > a.t_s:
@@ -168,8 +182,8 @@ def markdown(results: Sequence[SoakResult], load: str) -> list[str]:
         f"Load average (1, 5, 15 min) {load}; 2 shared cores.",
         "",
         "| soak | rate (Hz) | minutes | messages handled | RSS start (MB) | RSS 1 min (MB) "
-        "| RSS end (MB) | growth after 1 min | < 5 % |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| RSS end (MB) | growth after 1 min | < 5 % | trend after 1 min (MB/min) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         start, minute, end = r.samples[0], r.at(60.0), r.samples[-1]
@@ -177,7 +191,7 @@ def markdown(results: Sequence[SoakResult], load: str) -> list[str]:
         lines.append(
             f"| {r.name} | {r.rate_hz:.0f} | {end.t_s / 60.0:.1f} | {end.handled:,} {r.what} "
             f"| {mb(start.rss_kb)} | {mb(minute.rss_kb)} | {mb(end.rss_kb)} | {g:+.2f} % "
-            f"| {'yes' if g < GROWTH_LIMIT_PCT else 'NO'} |"
+            f"| {'yes' if g < GROWTH_LIMIT_PCT else 'NO'} | {trend_mb_per_min(r.samples):+.3f} |"
         )
     for r in results:
         keys = sorted({k for s in r.samples for k in s.figures})
@@ -244,6 +258,40 @@ def rss_kb(pid: int) -> int:
     raise RuntimeError(f"no VmRSS for pid {pid}")
 
 
+def smaps_breakdown(smaps: str) -> dict[str, float]:
+    """RSS by kind of mapping (MB) from /proc/<pid>/smaps: the main heap; glibc's other malloc
+    arenas (one per thread that allocates: anonymous mappings at 64 MiB-aligned addresses); other
+    anonymous mappings (big allocations, the TSDF's 2 MiB chunks, stacks of threads); files
+    (libraries); how much of all anonymous memory sits in transparent huge pages."""
+    kb = {"heap": 0, "malloc arenas": 0, "anonymous": 0, "huge pages": 0, "files": 0, "other": 0}
+    kind = "other"
+    for line in smaps.splitlines():
+        fields = line.split()
+        if not fields:
+            continue
+        if "-" in fields[0] and not fields[0].endswith(":"):  # a mapping's header line
+            path = fields[5] if len(fields) > 5 else ""
+            start = int(fields[0].split("-")[0], 16)
+            if path == "[heap]":
+                kind = "heap"
+            elif not path:
+                kind = "malloc arenas" if start % (64 << 20) == 0 else "anonymous"
+            else:
+                kind = "files" if path.startswith("/") else "other"
+        elif fields[0] == "Rss:":
+            kb[kind] += int(fields[1])
+        elif fields[0] == "AnonHugePages:":
+            kb["huge pages"] += int(fields[1])
+    return {f"RSS {k} (MB)": v / 1024.0 for k, v in kb.items()}
+
+
+def rss_figures(pid: int) -> dict[str, float]:
+    try:
+        return smaps_breakdown(Path(f"/proc/{pid}/smaps").read_text())
+    except OSError:
+        return {}
+
+
 class Processes:
     """What this script started, each in a session of its own (so a Ctrl-C reaches this script
     only, and stop() ends each group: roslaunch and its nodes)."""
@@ -307,6 +355,17 @@ class Diagnostics:
             return next((v for k, v in self.latest.items() if k.endswith(suffix)), {})
 
 
+def final_status(diagnostics: Diagnostics, suffixes: Sequence[str]) -> list[str]:
+    """The last diagnostics summaries (a WARN that stays, e.g. messages stuck waiting for tf)."""
+    notes = []
+    for suffix in suffixes:
+        v = diagnostics.get(suffix)
+        waits = {k: x for k, x in v.items() if "waiting for tf" in k}
+        detail = f"; {waits}" if waits else ""
+        notes.append(f"last diagnostics '{suffix[2:]}': {v.get('_message', '(none)')}{detail}")
+    return notes
+
+
 def node_pid(name: str, timeout_s: float = 60.0) -> int:
     """The pid of a node on our master (its XML-RPC getPid)."""
     import xmlrpc.client
@@ -353,7 +412,9 @@ def sample_loop(
         t = time.time() - t0
         if t >= next_sample or t >= 60.0 * minutes:
             try:
-                samples.append(Sample(t, rss_kb(pid), handled(), figures()))
+                f = figures()
+                f.update(rss_figures(pid))
+                samples.append(Sample(t, rss_kb(pid), handled(), f))
             except (FileNotFoundError, ProcessLookupError):
                 notes.append(f"the manager (pid {pid}) died at {t:.0f} s")
                 break
@@ -565,6 +626,7 @@ def costmap_soak(procs: Processes, port: int, out: Path, minutes: float) -> Soak
             sub.unregister()
         diagnostics.sub.unregister()
         feed.pub.unregister()
+    notes += final_status(diagnostics, (": costmap", ": layer obstacles"))
     held = feed.rate_hz
     notes.insert(0, f"scan rate held after the ramp: {held:.0f} Hz ({NUM_BEAMS} beams)")
     if holding[0] and samples and samples[-1].t_s > step_start[0]:
@@ -600,6 +662,7 @@ def tsdf_soak(procs: Processes, port: int, out: Path, minutes: float) -> SoakRes
         "TSDF memory (MB)": "memory (MB)",
         "blocks evicted by distance": "blocks evicted by distance (total)",
         "integration mean (ms)": "integration time mean (ms)",
+        "mesh triangles": "mesh triangles",
         "OctoMap observations inserted": "octomap: observations inserted",
         "OctoMap observations dropped": "octomap: observations dropped (queue full: insertion "
         "slower than the sensor)",
@@ -620,6 +683,7 @@ def tsdf_soak(procs: Processes, port: int, out: Path, minutes: float) -> SoakRes
     finally:
         procs.stop_all()
         diagnostics.sub.unregister()
+    notes += final_status(diagnostics, (": tsdf",))
     notes.insert(0, "depth frames 320x240 at 15 Hz, the camera walking a corridor at 1 m/s")
     return SoakResult("tsdf", "frames integrated", TSDF_RATE_HZ, samples, notes)
 

@@ -51,6 +51,13 @@ def test_growth_after_the_first_minute_uses_the_sample_at_one_minute(soak: Any) 
         soak.sample_at([], 0.0)
 
 
+def test_trend_is_the_slope_after_the_first_minute(soak: Any) -> None:
+    # Start-up (0 -> 60 s) is left out; then 1 MB per minute, minutes 2 and 3 0.5 MB above the line.
+    rss = [(0.0, 1024), (60.0, 10_240), (120.0, 11_776), (180.0, 12_800), (240.0, 13_312)]
+    assert soak.trend_mb_per_min(result(soak, rss).samples) == pytest.approx(1.0)
+    assert math.isnan(soak.trend_mb_per_min(result(soak, rss[:2]).samples))
+
+
 def test_rate_between_samples(soak: Any) -> None:
     a = soak.Sample(10.0, 1, handled=100, figures={"scans sent": 110.0})
     b = soak.Sample(20.0, 1, handled=1100, figures={"scans sent": 1210.0})
@@ -100,8 +107,9 @@ def test_table_and_closing_line(soak: Any) -> None:
     flat.notes = ["held 10 Hz"]
     text = "\n".join(soak.markdown([flat, grows], "1.00, 1.00, 1.00"))
     rows = {line.split(" | ")[0]: line for line in text.splitlines() if line.startswith("| ")}
-    assert rows["| tsdf"].endswith("| 10.0 | 20.0 | 22.0 | +10.00 % | NO |")
-    assert rows["| costmap"].endswith("| 10.0 | 20.0 | 20.0 | +0.00 % | yes |")
+    # 20 -> 22 MB from minute 1 to 10: +10 %, 2/9 MB per minute.
+    assert rows["| tsdf"].endswith("| 10.0 | 20.0 | 22.0 | +10.00 % | NO | +0.222 |")
+    assert rows["| costmap"].endswith("| 10.0 | 20.0 | 20.0 | +0.00 % | yes | +0.000 |")
     assert "9,000 frames integrated" in rows["| tsdf"]
     assert "| blocks | 100 | 160 | 700 |" in text  # diagnostics at start, 1 min, end
     assert "| 10 | 10 | nan | nan | nan | yes |" in text  # the ramp's step
@@ -122,3 +130,34 @@ def test_csv_has_every_sample_and_figure(soak: Any, tmp_path: Path) -> None:
     assert lines[0] == "t_s,rss_kb,handled,OctoMap leaves,blocks"
     assert lines[1] == "0.0,1000,0,,100.0"
     assert lines[2] == "5.0,1001,75,7.0,105.0"
+
+
+SMAPS = """\
+55d0c0a00000-55d0c0b00000 rw-p 00000000 00:00 0                          [heap]
+Rss:                2048 kB
+AnonHugePages:         0 kB
+7f0000000000-7f0000400000 rw-p 00000000 00:00 0
+Size:               4096 kB
+Rss:                3072 kB
+AnonHugePages:      2048 kB
+7f0000400000-7f0004000000 ---p 00000000 00:00 0
+Rss:                   0 kB
+7f0008200000-7f0008400000 rw-p 00000000 00:00 0
+Rss:                1024 kB
+AnonHugePages:      1024 kB
+7f1000000000-7f1000100000 r-xp 00000000 08:01 1234                       /usr/lib/libx.so
+Rss:                 512 kB
+AnonHugePages:         0 kB
+7ffd00000000-7ffd00021000 rw-p 00000000 00:00 0                          [stack]
+Rss:                 128 kB
+"""
+
+
+def test_smaps_breakdown_sums_rss_by_kind_of_mapping(soak: Any) -> None:
+    b = soak.smaps_breakdown(SMAPS)
+    assert b["RSS heap (MB)"] == 2.0
+    assert b["RSS malloc arenas (MB)"] == 3.0  # unnamed, at a 64 MiB-aligned address
+    assert b["RSS anonymous (MB)"] == 1.0  # unnamed elsewhere
+    assert b["RSS huge pages (MB)"] == 3.0  # of both, in transparent huge pages
+    assert b["RSS files (MB)"] == 0.5
+    assert b["RSS other (MB)"] == 0.125  # the stack
