@@ -22,6 +22,7 @@
 #include <boost/thread/recursive_mutex.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -64,6 +65,10 @@ class TsdfRos {
                       const std::string& what, int queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
+  /// malloc_trim every kTrimPeriodS (on the mesh timer): freed memory goes back to the OS.
+  void returnFreeMemory();
+  static constexpr int kTrimPeriodS = 5;
+  std::chrono::steady_clock::time_point last_trim_{};
   /// Centres of the OctoMap's occupied leaves as a PointCloud2 (x, y, z) for rviz.
   sensor_msgs::PointCloud2Ptr occupiedCloud(const std_msgs::Header& header);
   bool saveOctomap(SaveMap::Request& request, SaveMap::Response& response);
