@@ -4,7 +4,7 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 mkdir -p "$WS/src" "$ROS_HOME"
-ln -sfn "$REPO" "$WS/src/downstream_perception"
+link_package "$WS"
 cd "$WS"
 if [[ -f build/CMakeCache.txt ]] && ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" build/CMakeCache.txt; then
   rm -rf build devel  # a cache configured with another python (pitfall P14)

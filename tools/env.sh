@@ -23,3 +23,20 @@ system_venv() {
     /usr/bin/python3 -m venv --system-site-packages "$1"
   fi
 }
+link_package() {
+  # The package as the workspace's source ($1/src/downstream_perception): a directory of links to
+  # the repository's entries, not one link to the repository, so that it does not contain the
+  # workspaces themselves (.ws*). rosrun searches the package directory recursively: through a
+  # link to the repository it found every script again in .ws/devel, .ws/build and the loop
+  # .ws/src/downstream_perception/.ws/... and refused to choose.
+  local dest="$1/src/downstream_perception" entry name
+  [[ -L "$dest" ]] && rm -f "$dest"
+  mkdir -p "$dest"
+  find "$dest" -mindepth 1 -maxdepth 1 -type l -delete
+  for entry in "$REPO"/* "$REPO"/.[!.]*; do
+    name="$(basename "$entry")"
+    [[ -e "$entry" ]] || continue
+    case "$name" in .ws* | .git | .ruff_cache | out) continue ;; esac
+    ln -sfn "$entry" "$dest/$name"
+  done
+}

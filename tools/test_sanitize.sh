@@ -10,7 +10,7 @@ SAN_WS="$REPO/.ws-san"
 SAN_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 RESULTS="$SAN_WS/results"
 mkdir -p "$SAN_WS/src" "$ROS_HOME"
-ln -sfn "$REPO" "$SAN_WS/src/downstream_perception"
+link_package "$SAN_WS"
 cd "$SAN_WS"
 if [[ -f build/CMakeCache.txt ]] && ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" build/CMakeCache.txt; then
   rm -rf build devel # a cache configured with another python (pitfall P14)
@@ -71,7 +71,7 @@ if [[ "$module" != "$SAN_WS/devel/"* ]] || ! grep -q __asan_init <<< "$symbols";
   exit 1
 fi
 echo "sanitize: python imports $module (instrumented)"
-(cd "$REPO" && LD_PRELOAD="$preload" "$python" -m pytest -q -p no:cacheprovider test/pytest \
+(cd "$REPO" && DP_PARTIAL_BUILD=1 LD_PRELOAD="$preload" "$python" -m pytest -q -p no:cacheprovider test/pytest \
   --junitxml="$RESULTS/pytest.xml") > "$RESULTS/pytest.log" 2>&1 || status=1
 tail -1 "$RESULTS/pytest.log"
 
