@@ -37,6 +37,8 @@ class CostmapRos {
  private:
   using ReconfigureServer = dynamic_reconfigure::Server<CostmapConfig>;
   void loadPlugins();
+  /// WARNs for host-level keys nobody reads (after the layers are loaded).
+  void auditKeys(ParamReader& params);
   void reconfigure(CostmapConfig& cfg, std::uint32_t level);
   void updateTimerCallback(const ros::TimerEvent& event);
   /// Resets what depends on time when the ROS clock went back.
@@ -45,13 +47,16 @@ class CostmapRos {
   bool clearService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status);
   void applyFootprint();
-  void reportError(const std::string& msg);
+  /// Replaces the entries of `keys` and adds `errors` (by key) to the config errors.
+  void setErrors(const ConfigErrors& errors, const std::vector<std::string>& keys);
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
   CostmapRosConfig config_;
   std::mutex errors_mutex_;
-  std::vector<std::string> config_errors_;
+  ConfigErrors config_errors_;               ///< by key: a later valid value clears its entry
+  std::vector<std::string> param_warnings_;  ///< wrong types, unknown / unsupported keys (start-up)
+  std::vector<std::string> layer_types_;     ///< the loaded layers' types as configured
 
   std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

@@ -2,25 +2,26 @@
 // validation: an absurd value is reported and replaced by the fallback's, never used.
 #pragma once
 
-#include <ros/node_handle.h>
-
+#include <map>
 #include <string>
 #include <vector>
+
+#include "downstream_perception/param_reader.h"
 
 namespace downstream_perception {
 
 struct CostmapRosConfig {
   std::string global_frame = "map";
   std::string robot_base_frame = "base_link";
-  double update_frequency = 5.0;     ///< Hz
-  double publish_frequency = 1.0;    ///< Hz; 0 = never publish
-  double width = 10.0;               ///< m
-  double height = 10.0;              ///< m
-  double resolution = 0.05;          ///< m / cell
-  double origin_x = 0.0;             ///< m, lower-left corner in global_frame
-  double origin_y = 0.0;             ///< m
-  double transform_tolerance = 0.3;  ///< s: oldest acceptable robot pose
-  bool track_unknown_space = true;
+  double update_frequency = 5.0;          ///< Hz
+  double publish_frequency = 0.0;         ///< Hz; 0 = never publish (costmap_2d's default)
+  double width = 10.0;                    ///< m
+  double height = 10.0;                   ///< m
+  double resolution = 0.05;               ///< m / cell
+  double origin_x = 0.0;                  ///< m, lower-left corner in global_frame
+  double origin_y = 0.0;                  ///< m
+  double transform_tolerance = 0.3;       ///< s: oldest acceptable robot pose
+  bool track_unknown_space = false;       ///< costmap_2d's default: unknown cells are free
   bool rolling_window = false;            ///< keep the map centred on the robot (whole-cell shifts)
   bool always_send_full_costmap = false;  ///< no ~costmap_updates: the whole grid every time
 
@@ -28,12 +29,20 @@ struct CostmapRosConfig {
   int sizeYCells() const;
 };
 
-/// Reads every field from `pnh` (defaults for the missing ones), then validates.
-CostmapRosConfig readCostmapConfig(const ros::NodeHandle& pnh, std::vector<std::string>* errors);
+/// Parameter problems by key (a later valid value for the key clears its entry).
+using ConfigErrors = std::map<std::string, std::string>;
+
+/// Reads every field through `params` (defaults for the missing ones; a value of the wrong type
+/// is named and the default used), then validates.
+CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrors* errors);
+
+/// The host-level keys readCostmapConfig() reads (for the unknown-key audit).
+const std::vector<std::string>& costmapConfigKeys();
 
 /// Replaces each invalid field of *config by the one of `fallback`, reporting each into *errors
-/// (and the log) by parameter name, value and what is used instead.
+/// (and the log) by parameter name, value and what is used instead. Every key it checks that is
+/// valid now has its entry erased from *errors.
 void validateCostmapConfig(CostmapRosConfig* config, const CostmapRosConfig& fallback,
-                           std::vector<std::string>* errors);
+                           ConfigErrors* errors);
 
 }  // namespace downstream_perception

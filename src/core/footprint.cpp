@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 
@@ -46,13 +47,71 @@ Footprint circularFootprint(double radius_m) {
   return polygon;
 }
 
+namespace {
+double sign0(double v) {
+  return v < 0.0 ? -1.0 : (v > 0.0 ? 1.0 : 0.0);
+}
+}  // namespace
+
 Footprint padFootprint(const Footprint& polygon, double padding_m) {
   Footprint out = polygon;
   for (FootprintPoint& p : out) {
-    p.x += (p.x >= 0.0 ? 1.0 : -1.0) * padding_m;
-    p.y += (p.y >= 0.0 ? 1.0 : -1.0) * padding_m;
+    p.x += sign0(p.x) * padding_m;
+    p.y += sign0(p.y) * padding_m;
   }
   return out;
+}
+
+Footprint parseFootprintString(const std::string& text, std::string* error) {
+  // One pass over the characters, as costmap_2d's parser reads them: '[' opens (depth <= 2),
+  // ']' closes (a depth-2 close ends a point), ',' and blanks separate, anything else must be a
+  // number inside a point.
+  std::vector<std::vector<double>> points;
+  std::vector<double> current;
+  int depth = 0;
+  std::size_t k = 0;
+  const auto fail = [&](const std::string& why) {
+    *error = why + " in footprint string '" + text + "'";
+    return Footprint{};
+  };
+  while (k < text.size()) {
+    const char c = text[k];
+    if (c == '[') {
+      if (++depth > 2) return fail("brackets nested deeper than [[x, y], ...]");
+      current.clear();
+      ++k;
+    } else if (c == ']') {
+      if (--depth < 0) return fail("more ']' than '['");
+      if (depth == 1) points.push_back(current);
+      ++k;
+    } else if (c == ',' || c == ' ' || c == '\t' || c == '\n' || c == '\r') {
+      ++k;
+    } else {
+      if (depth != 2) {
+        return fail(std::string("'") + c + "' outside a point (numbers belong at depth 2)");
+      }
+      const char* begin = text.c_str() + k;
+      char* end = nullptr;
+      const double v = std::strtod(begin, &end);
+      if (end == begin) return fail(std::string("'") + c + "' is not part of a number");
+      current.push_back(v);
+      k += static_cast<std::size_t>(end - begin);
+    }
+  }
+  if (depth != 0) return fail("unterminated: more '[' than ']'");
+  if (points.size() < 3) {
+    return fail("a footprint needs at least 3 points, got " + std::to_string(points.size()));
+  }
+  Footprint polygon;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].size() != 2) {
+      return fail("point " + std::to_string(i + 1) + " has " + std::to_string(points[i].size()) +
+                  " numbers, not 2");
+    }
+    polygon.push_back({points[i][0], points[i][1]});
+  }
+  error->clear();
+  return polygon;
 }
 
 double inscribedRadius(const Footprint& polygon) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "downstream_perception/config_errors.h"
+#include "downstream_perception/costmap_plugin_list.h"
 #include "downstream_perception/footprint_params.h"
 
 namespace downstream_perception {
@@ -14,7 +15,8 @@ namespace downstream_perception {
 CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     // Named after this costmap, not the process: several nodelets share one manager.
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
-  config_ = readCostmapConfig(pnh_, &config_errors_);
+  ParamReader params(pnh_, "costmap");
+  config_ = readCostmapConfig(params, &config_errors_);
   tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
   plugin_loader_ = std::make_unique<pluginlib::ClassLoader<Layer>>("downstream_perception",
@@ -30,6 +32,7 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.setHardwareID("costmap " + config_.global_frame);
   diagnostics_.add("costmap", this, &CostmapRos::diagnoseCostmap);
   loadPlugins();
+  auditKeys(params);
 
   publisher_ = std::make_unique<CostmapPublisher>(pnh_, "costmap", config_.global_frame,
                                                   config_.always_send_full_costmap);
@@ -60,15 +63,22 @@ CostmapRos::~CostmapRos() {
   layered_costmap_.reset();
 }
 
-void CostmapRos::reportError(const std::string& msg) {
+void CostmapRos::setErrors(const ConfigErrors& errors, const std::vector<std::string>& keys) {
   std::lock_guard<std::mutex> lock(errors_mutex_);
-  config_errors_.push_back(msg);
+  for (const auto& key : keys) config_errors_.erase(key);
+  for (const auto& entry : errors) config_errors_[entry.first] = entry.second;
 }
 
 void CostmapRos::applyFootprint() {
   std::vector<std::string> errors;
   layered_costmap_->setFootprint(readFootprint(pnh_, &errors));
-  for (const auto& e : errors) reportError(e);
+  ConfigErrors by_key;
+  for (std::size_t k = 0; k < errors.size(); ++k) by_key["footprint " + toText(k)] = errors[k];
+  std::lock_guard<std::mutex> lock(errors_mutex_);
+  for (auto it = config_errors_.begin(); it != config_errors_.end();) {
+    it = it->first.rfind("footprint ", 0) == 0 ? config_errors_.erase(it) : std::next(it);
+  }
+  config_errors_.insert(by_key.begin(), by_key.end());
   // Latched, in the robot frame, stamp 0: the shape holds at every time, so rviz draws it
   // wherever the robot is now (a start-up stamp would predate the robot's first tf). Sent again
   // with every costmap publish: a viewer whose tf was not ready for the first one catches up.
@@ -102,9 +112,20 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
     next.origin_y = cfg.origin_y;
   }
   next.always_send_full_costmap = cfg.always_send_full_costmap;
-  std::vector<std::string> errors;
+  ConfigErrors errors;
   validateCostmapConfig(&next, config_, &errors);
-  for (const auto& e : errors) reportError(e);
+  setErrors(errors, {"update_frequency", "publish_frequency", "transform_tolerance",
+                     "width/height/resolution/origin"});
+  // A rejected value is reverted in the server too: the server applies what this callback
+  // leaves in cfg, so rqt_reconfigure shows the value in use, not the refused one.
+  cfg.update_frequency = next.update_frequency;
+  cfg.publish_frequency = next.publish_frequency;
+  cfg.transform_tolerance = next.transform_tolerance;
+  cfg.width = next.width;
+  cfg.height = next.height;
+  cfg.resolution = next.resolution;
+  cfg.origin_x = next.origin_x;
+  cfg.origin_y = next.origin_y;
 
   std::lock_guard<std::mutex> busy(update_mutex_);  // no update while the map changes
   const bool resize = next.sizeXCells() != config_.sizeXCells() ||
@@ -142,45 +163,49 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
 }
 
 void CostmapRos::loadPlugins() {
-  XmlRpc::XmlRpcValue plugins;
-  if (!pnh_.getParam("plugins", plugins)) {
-    ROS_WARN("costmap: no ~plugins parameter; the costmap will stay at its default value");
-    return;
-  }
-  if (plugins.getType() != XmlRpc::XmlRpcValue::TypeArray) {
-    const std::string msg = "~plugins must be a list of {name, type}";
-    ROS_ERROR("costmap: %s", msg.c_str());
-    reportError(msg);
-    return;
-  }
-  for (int k = 0; k < plugins.size(); ++k) {
-    XmlRpc::XmlRpcValue& entry = plugins[k];
-    if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct || !entry.hasMember("name") ||
-        !entry.hasMember("type") || entry["name"].getType() != XmlRpc::XmlRpcValue::TypeString ||
-        entry["type"].getType() != XmlRpc::XmlRpcValue::TypeString) {
-      const std::string msg = "~plugins[" + std::to_string(k) + "] needs string 'name' and 'type'";
-      ROS_ERROR("costmap: %s", msg.c_str());
-      reportError(msg);
-      continue;
-    }
-    const std::string name = static_cast<std::string>(entry["name"]);
-    const std::string type = static_cast<std::string>(entry["type"]);
+  std::vector<std::string> errors;
+  const std::vector<LayerSpec> layers = readLayerList(pnh_, &errors, &param_warnings_);
+  for (const LayerSpec& spec : layers) {
+    std::string note;
+    const std::string type = ourLayerType(spec.type, &note);
+    if (!note.empty()) ROS_INFO("costmap: layer '%s': %s", spec.name.c_str(), note.c_str());
     try {
       std::shared_ptr<Layer> layer = plugin_loader_->createSharedInstance(type);
       layered_costmap_->addPlugin(layer);
-      layer->initialize(layered_costmap_.get(), name, tf_buffer_.get(), pnh_, nh_);
+      layer->initialize(layered_costmap_.get(), spec.name, tf_buffer_.get(), pnh_, nh_);
       layer->matchSize();
-      diagnostics_.add("layer " + name, [layer](diagnostic_updater::DiagnosticStatusWrapper& s) {
-        layer->diagnose(s);
-      });
-      ROS_INFO("costmap: loaded layer '%s' (%s)", name.c_str(), type.c_str());
+      diagnostics_.add(
+          "layer " + spec.name,
+          [layer](diagnostic_updater::DiagnosticStatusWrapper& s) { layer->diagnose(s); });
+      layer_types_.push_back(spec.type);
+      ROS_INFO("costmap: loaded layer '%s' (%s)", spec.name.c_str(), type.c_str());
     } catch (const pluginlib::PluginlibException& e) {
-      const std::string msg =
-          "cannot load layer '" + name + "' of type '" + type + "': " + e.what();
-      ROS_ERROR("costmap: %s", msg.c_str());
-      reportError(msg);
+      errors.push_back("cannot load layer '" + spec.name + "' of type '" + spec.type + "'" +
+                       (type != spec.type ? " (as " + type + ")" : std::string()) + ": " +
+                       e.what());
+      ROS_ERROR("costmap: %s", errors.back().c_str());
     }
   }
+  ConfigErrors by_key;
+  for (std::size_t k = 0; k < errors.size(); ++k) by_key["plugins " + toText(k)] = errors[k];
+  setErrors(by_key, {});
+}
+
+void CostmapRos::auditKeys(ParamReader& params) {
+  params.known(
+      {"plugins", "static_map", "map_type", "footprint", "robot_radius", "footprint_padding"});
+  params.unsupported("footprint_topic",
+                     "the footprint is read from ~footprint / robot_radius (also on "
+                     "dynamic_reconfigure) and published on ~footprint; no footprint subscriber");
+  params.unsupported("published_footprint_topic", "the footprint is published on ~footprint");
+  for (const auto& layer : layered_costmap_->plugins()) params.known({layer->name()});
+  for (const std::string& type : layer_types_) {
+    params.known(keysCopiedIntoLayer(type));
+    // costmap_2d's obstacle layers search these from each source upward (host level included).
+    params.known({"obstacle_range", "raytrace_range"});
+  }
+  params.warnUnknown();
+  param_warnings_.insert(param_warnings_.end(), params.warnings().begin(), params.warnings().end());
 }
 
 bool CostmapRos::clearService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -267,12 +292,22 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   std::vector<std::string> errors;
   {
     std::lock_guard<std::mutex> lock(errors_mutex_);
-    errors = config_errors_;
+    for (const auto& entry : config_errors_) errors.push_back(entry.second);
+  }
+  std::string stale;
+  for (const auto& layer : layered_costmap_->plugins()) {
+    if (layer->isEnabled() && !layer->isCurrent())
+      stale += (stale.empty() ? "" : ", ") + layer->name();
   }
   if (!errors.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, errors.front());
-  } else if (!layered_costmap_->isCurrent()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "a layer is not current");
+  } else if (layered_costmap_->plugins().empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                   "no layers: the costmap stays at its default value (set ~plugins)");
+  } else if (!stale.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "layer(s) not current: " + stale);
+  } else if (!param_warnings_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, param_warnings_.front());
   } else if (updates_ > 10 && achieved_hz < 0.8 * config_.update_frequency) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "update loop missed its rate");
   } else {
@@ -297,6 +332,10 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("clears (~clear)", clears_);
   status.add("clock jumps back", clock_jump_.jumps());
   addConfigErrors(status, errors);
+  status.add("parameter warnings", param_warnings_.size());
+  for (std::size_t k = 0; k < param_warnings_.size(); ++k) {
+    status.add("parameter warning " + toText(k + 1), param_warnings_[k]);
+  }
   status.add("footprint inscribed radius (m)", layered_costmap_->inscribedRadius());
   status.add("footprint circumscribed radius (m)", layered_costmap_->circumscribedRadius());
 }

@@ -24,33 +24,53 @@ int CostmapRosConfig::sizeYCells() const {
   return cells(height, resolution);
 }
 
-CostmapRosConfig readCostmapConfig(const ros::NodeHandle& pnh, std::vector<std::string>* errors) {
-  const CostmapRosConfig d;
+CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrors* errors) {
   CostmapRosConfig c;
-  pnh.param("global_frame", c.global_frame, d.global_frame);
-  pnh.param("robot_base_frame", c.robot_base_frame, d.robot_base_frame);
-  pnh.param("update_frequency", c.update_frequency, d.update_frequency);
-  pnh.param("publish_frequency", c.publish_frequency, d.publish_frequency);
-  pnh.param("width", c.width, d.width);
-  pnh.param("height", c.height, d.height);
-  pnh.param("resolution", c.resolution, d.resolution);
-  pnh.param("origin_x", c.origin_x, d.origin_x);
-  pnh.param("origin_y", c.origin_y, d.origin_y);
-  pnh.param("transform_tolerance", c.transform_tolerance, d.transform_tolerance);
-  pnh.param("track_unknown_space", c.track_unknown_space, d.track_unknown_space);
-  pnh.param("rolling_window", c.rolling_window, d.rolling_window);
-  pnh.param("always_send_full_costmap", c.always_send_full_costmap, d.always_send_full_costmap);
-  validateCostmapConfig(&c, d, errors);
+  params.get("global_frame", &c.global_frame);
+  params.get("robot_base_frame", &c.robot_base_frame);
+  params.get("update_frequency", &c.update_frequency);
+  params.get("publish_frequency", &c.publish_frequency);
+  params.get("width", &c.width);
+  params.get("height", &c.height);
+  params.get("resolution", &c.resolution);
+  params.get("origin_x", &c.origin_x);
+  params.get("origin_y", &c.origin_y);
+  params.get("transform_tolerance", &c.transform_tolerance);
+  params.get("track_unknown_space", &c.track_unknown_space);
+  params.get("rolling_window", &c.rolling_window);
+  params.get("always_send_full_costmap", &c.always_send_full_costmap);
+  validateCostmapConfig(&c, CostmapRosConfig(), errors);
   return c;
 }
 
+const std::vector<std::string>& costmapConfigKeys() {
+  static const std::vector<std::string> keys{"global_frame",
+                                             "robot_base_frame",
+                                             "update_frequency",
+                                             "publish_frequency",
+                                             "width",
+                                             "height",
+                                             "resolution",
+                                             "origin_x",
+                                             "origin_y",
+                                             "transform_tolerance",
+                                             "track_unknown_space",
+                                             "rolling_window",
+                                             "always_send_full_costmap"};
+  return keys;
+}
+
 void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback,
-                           std::vector<std::string>* errors) {
+                           ConfigErrors* errors) {
+  for (const char* key : {"update_frequency", "publish_frequency", "transform_tolerance",
+                          "width/height/resolution/origin"}) {
+    errors->erase(key);
+  }
   const auto reject = [errors](const std::string& name, const std::string& value,
                                const std::string& used) {
     const std::string msg = "parameter ~" + name + " = " + value + " is invalid; using " + used;
     ROS_ERROR("costmap: %s", msg.c_str());
-    errors->push_back(msg);
+    (*errors)[name] = msg;
   };
   if (!std::isfinite(c->update_frequency) || c->update_frequency <= 0.0 ||
       c->update_frequency > 1000.0) {

@@ -4,7 +4,6 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <cmath>
-#include <sstream>
 
 namespace downstream_perception {
 
@@ -13,24 +12,33 @@ namespace {
 constexpr double kDefaultRobotRadius = 0.46;  // m, costmap_2d's default
 constexpr double kDefaultPadding = 0.01;      // m, costmap_2d's default
 
-double asDouble(const XmlRpc::XmlRpcValue& v) {
+double asDouble(XmlRpc::XmlRpcValue& v) {
   if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(v);
   if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(v);
   return std::nan("");
 }
 
-// "[[x, y], [x, y], ...]" -> points; empty on a parse error.
-Footprint parseString(const std::string& text) {
-  std::string cleaned;
-  for (const char c : text) cleaned += (c == '[' || c == ']' || c == ',') ? ' ' : c;
-  std::istringstream in(cleaned);
-  std::vector<double> values;
-  double v = 0.0;
-  while (in >> v) values.push_back(v);
-  if (!in.eof() || values.size() % 2 != 0) return {};
+// A list [[x, y], ...]: every element a pair of numbers, >= 3 of them (costmap_2d's rule).
+Footprint parseList(XmlRpc::XmlRpcValue& raw, std::string* error) {
   Footprint polygon;
-  for (std::size_t i = 0; i + 1 < values.size(); i += 2)
-    polygon.push_back({values[i], values[i + 1]});
+  if (raw.size() < 3) {
+    *error = "a footprint needs at least 3 points, got " + std::to_string(raw.size());
+    return {};
+  }
+  for (int i = 0; i < raw.size(); ++i) {
+    if (raw[i].getType() != XmlRpc::XmlRpcValue::TypeArray || raw[i].size() != 2) {
+      *error = "point " + std::to_string(i + 1) + " is not a pair [x, y]";
+      return {};
+    }
+    const double x = asDouble(raw[i][0]);
+    const double y = asDouble(raw[i][1]);
+    if (std::isnan(x) || std::isnan(y)) {
+      *error = "point " + std::to_string(i + 1) + " holds something other than numbers";
+      return {};
+    }
+    polygon.push_back({x, y});
+  }
+  error->clear();
   return polygon;
 }
 
@@ -48,29 +56,33 @@ Footprint readFootprint(const ros::NodeHandle& pnh, std::vector<std::string>* er
     report(errors, "parameter ~footprint_padding is invalid; using 0.01 m");
     padding = kDefaultPadding;
   }
-  Footprint polygon;
+  // costmap_2d looks both keys up from the costmap's namespace upward: a move_base-level
+  // footprint serves both costmaps.
+  std::string key;
   XmlRpc::XmlRpcValue raw;
-  if (pnh.getParam("footprint", raw)) {
-    if (raw.getType() == XmlRpc::XmlRpcValue::TypeString) {
-      polygon = parseString(static_cast<std::string>(raw));
+  if (pnh.searchParam("footprint", key) && pnh.getParam(key, raw)) {
+    Footprint polygon;
+    std::string why;
+    const bool is_string = raw.getType() == XmlRpc::XmlRpcValue::TypeString;
+    const std::string text = is_string ? static_cast<std::string>(raw) : std::string();
+    if (is_string && (text.empty() || text == "[]")) {
+      why = "";  // costmap_2d's "no polygon": the radius is used
+    } else if (is_string) {
+      polygon = parseFootprintString(text, &why);
     } else if (raw.getType() == XmlRpc::XmlRpcValue::TypeArray) {
-      for (int i = 0; i < raw.size(); ++i) {
-        if (raw[i].getType() != XmlRpc::XmlRpcValue::TypeArray || raw[i].size() != 2) {
-          polygon.clear();
-          break;
-        }
-        polygon.push_back({asDouble(raw[i][0]), asDouble(raw[i][1])});
-      }
+      polygon = parseList(raw, &why);
+    } else {
+      why = "neither a list [[x, y], ...] nor a string";
     }
-    const std::string why = validateFootprint(polygon);
-    if (why.empty()) return padFootprint(polygon, padding);
-    report(errors, "parameter ~footprint is invalid (" + why +
-                       "); expected [[x, y], ...] with >= 3 points; using ~robot_radius");
+    if (why.empty() && !polygon.empty()) why = validateFootprint(polygon);
+    if (why.empty() && !polygon.empty()) return padFootprint(polygon, padding);
+    if (!why.empty())
+      report(errors, "parameter " + key + " is invalid (" + why + "); using the robot radius");
   }
   double radius = kDefaultRobotRadius;
-  pnh.param("robot_radius", radius, kDefaultRobotRadius);
+  if (pnh.searchParam("robot_radius", key)) pnh.param(key, radius, kDefaultRobotRadius);
   if (!std::isfinite(radius) || radius < 0.0 || radius > 100.0) {
-    report(errors, "parameter ~robot_radius is invalid; using 0.46 m");
+    report(errors, "parameter robot_radius is invalid; using 0.46 m");
     radius = kDefaultRobotRadius;
   }
   return padFootprint(circularFootprint(radius), padding);

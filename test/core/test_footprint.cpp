@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "downstream_perception/core/footprint.h"
 
@@ -80,4 +83,44 @@ TEST(Footprint, PolygonCellsRotatedClippedAndConcave) {
   Footprint bad = square;
   bad[1].x = std::nan("");
   EXPECT_TRUE(polygonCells(bad, g, &cells).empty());
+}
+
+TEST(FootprintPadding, ACoordinateThatIsExactlyZeroStaysZero) {
+  // costmap_2d's sign0: (0.46, 0) padded by 0.01 is (0.47, 0), not (0.47, 0.01).
+  const Footprint padded = padFootprint({{0.46, 0.0}, {0.0, -0.3}, {-0.2, 0.25}}, 0.01);
+  EXPECT_DOUBLE_EQ(padded[0].x, 0.47);
+  EXPECT_DOUBLE_EQ(padded[0].y, 0.0);
+  EXPECT_DOUBLE_EQ(padded[1].x, 0.0);
+  EXPECT_DOUBLE_EQ(padded[1].y, -0.31);
+  EXPECT_DOUBLE_EQ(padded[2].x, -0.21);
+  EXPECT_DOUBLE_EQ(padded[2].y, 0.26);
+}
+
+TEST(FootprintString, ParsesCostmap2dSyntax) {
+  std::string error;
+  const Footprint f =
+      parseFootprintString("[[0.3, -0.25],[0.3,0.25], [-.3, 0.25],\t[-0.3,-2e-1]]", &error);
+  EXPECT_EQ(error, "");
+  ASSERT_EQ(f.size(), 4u);
+  EXPECT_DOUBLE_EQ(f[2].x, -0.3);
+  EXPECT_DOUBLE_EQ(f[3].y, -0.2);
+}
+
+TEST(FootprintString, RefusesWhatCostmap2dRefuses) {
+  // Each of these is an error in costmap_2d's parser; ours used to accept the first two.
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"[1, 2.2], [.3, -4], [0, 1]]", "outside a point"},
+      {"[[1,2,3],[4,5,6]]", "at least 3 points, got 2"},
+      {"[[1,2,3],[4,5,6],[7,8,9]]", "point 1 has 3 numbers"},
+      {"[[[1,2],[3,4],[5,6]]]", "nested deeper"},
+      {"[[1,2],[3,4],[5,6]]]", "more ']' than '['"},
+      {"[[1,2],[3,4],[5,6]", "unterminated"},
+      {"[[1,2],[3,x],[5,6]]", "'x' is not part of a number"},
+  };
+  for (const auto& c : cases) {
+    std::string error;
+    const Footprint f = parseFootprintString(c.first, &error);
+    EXPECT_TRUE(f.empty()) << c.first;
+    EXPECT_NE(error.find(c.second), std::string::npos) << c.first << " -> " << error;
+  }
 }

@@ -22,8 +22,13 @@ std::string validateFootprint(const Footprint& polygon);
 /// A regular 16-gon of the given radius (costmap_2d's robot_radius footprint).
 Footprint circularFootprint(double radius_m);
 /// Moves every vertex `padding_m` farther from the origin along each axis (costmap_2d's
-/// footprint_padding: x and y grow by padding with the vertex's sign).
+/// footprint_padding: x and y grow by padding with the vertex's sign; a coordinate that is
+/// exactly 0 stays 0, as costmap_2d's sign0 keeps it).
 Footprint padFootprint(const Footprint& polygon, double padding_m);
+/// costmap_2d's footprint string, "[[x, y], [x, y], ...]", parsed with its strictness: brackets
+/// must nest to depth 2 and balance, numbers only at depth 2, >= 3 points of exactly 2 numbers.
+/// Empty *error on success, else the reason (and an empty footprint).
+Footprint parseFootprintString(const std::string& text, std::string* error);
 /// Shortest distance from the origin to the polygon's edges (costmap_2d's inscribed radius).
 double inscribedRadius(const Footprint& polygon);
 /// Largest distance from the origin to a vertex (circumscribed radius).
