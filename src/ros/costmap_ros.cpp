@@ -65,20 +65,16 @@ CostmapRos::~CostmapRos() {
 
 void CostmapRos::setErrors(const ConfigErrors& errors, const std::vector<std::string>& keys) {
   std::lock_guard<std::mutex> lock(errors_mutex_);
-  for (const auto& key : keys) config_errors_.erase(key);
-  for (const auto& entry : errors) config_errors_[entry.first] = entry.second;
+  for (const auto& key : keys) config_errors_.eraseWithPrefix(key);
+  config_errors_.merge(errors);
 }
 
 void CostmapRos::applyFootprint() {
   std::vector<std::string> errors;
   layered_costmap_->setFootprint(readFootprint(pnh_, &errors));
   ConfigErrors by_key;
-  for (std::size_t k = 0; k < errors.size(); ++k) by_key["footprint " + toText(k)] = errors[k];
-  std::lock_guard<std::mutex> lock(errors_mutex_);
-  for (auto it = config_errors_.begin(); it != config_errors_.end();) {
-    it = it->first.rfind("footprint ", 0) == 0 ? config_errors_.erase(it) : std::next(it);
-  }
-  config_errors_.insert(by_key.begin(), by_key.end());
+  for (std::size_t k = 0; k < errors.size(); ++k) by_key.set("footprint " + toText(k), errors[k]);
+  setErrors(by_key, {"footprint "});
   // Latched, in the robot frame, stamp 0: the shape holds at every time, so rviz draws it
   // wherever the robot is now (a start-up stamp would predate the robot's first tf). Sent again
   // with every costmap publish: a viewer whose tf was not ready for the first one catches up.
@@ -187,7 +183,7 @@ void CostmapRos::loadPlugins() {
     }
   }
   ConfigErrors by_key;
-  for (std::size_t k = 0; k < errors.size(); ++k) by_key["plugins " + toText(k)] = errors[k];
+  for (std::size_t k = 0; k < errors.size(); ++k) by_key.set("plugins " + toText(k), errors[k]);
   setErrors(by_key, {});
 }
 
@@ -292,7 +288,7 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   std::vector<std::string> errors;
   {
     std::lock_guard<std::mutex> lock(errors_mutex_);
-    for (const auto& entry : config_errors_) errors.push_back(entry.second);
+    errors = config_errors_.messages();
   }
   std::string stale;
   for (const auto& layer : layered_costmap_->plugins()) {

@@ -64,13 +64,13 @@ void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback
                            ConfigErrors* errors) {
   for (const char* key : {"update_frequency", "publish_frequency", "transform_tolerance",
                           "width/height/resolution/origin"}) {
-    errors->erase(key);
+    errors->eraseWithPrefix(key);
   }
   const auto reject = [errors](const std::string& name, const std::string& value,
                                const std::string& used) {
     const std::string msg = "parameter ~" + name + " = " + value + " is invalid; using " + used;
     ROS_ERROR("costmap: %s", msg.c_str());
-    (*errors)[name] = msg;
+    errors->set(name, msg);
   };
   if (!std::isfinite(c->update_frequency) || c->update_frequency <= 0.0 ||
       c->update_frequency > 1000.0) {
