@@ -28,6 +28,15 @@ inline void addConfigErrors(diagnostic_updater::DiagnosticStatusWrapper& status,
   }
 }
 
+/// Parameter warnings (wrong types, unknown or unsupported keys: ParamReader) into a status.
+inline void addParamWarnings(diagnostic_updater::DiagnosticStatusWrapper& status,
+                             const std::vector<std::string>& warnings) {
+  status.add("parameter warnings", warnings.size());
+  for (std::size_t k = 0; k < warnings.size(); ++k) {
+    status.add("parameter warning " + std::to_string(k + 1), warnings[k]);
+  }
+}
+
 /// The parameter problems of one component (a layer, a nodelet): each logged once as an error
 /// with the component's prefix and kept for its diagnostics. Safe from any thread (start-up,
 /// dynamic_reconfigure callbacks, the diagnostics timer).

@@ -48,6 +48,14 @@ class ParamReader {
   bool has(const std::string& key) const { return nh_.hasParam(key); }
   /// Declares keys that are read elsewhere (a dynamic_reconfigure server, a sub-namespace).
   void known(const std::vector<std::string>& keys);
+  /// Declares the keys of a dynamic_reconfigure Config type and checks the type of those that
+  /// are set: the server itself would fall back to its default without a word.
+  template <class ReconfigureConfig>
+  void reconfigureKeys() {
+    for (const auto& description : ReconfigureConfig::__getParamDescriptions__()) {
+      checkType(description->name, description->type);
+    }
+  }
   /// Declares a key that costmap_2d reads but we do not implement: WARNs (once) if it is set.
   void unsupported(const std::string& key, const std::string& why);
   /// WARNs once for each key under the namespace that was neither read nor declared known;
@@ -60,6 +68,8 @@ class ParamReader {
 
  private:
   void warn(const std::string& msg);
+  /// `type` as dynamic_reconfigure names it: "double", "int", "bool", "str".
+  void checkType(const std::string& key, const std::string& type);
 
   ros::NodeHandle nh_;
   std::string who_;

@@ -8,6 +8,7 @@
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/layered_costmap.h"
+#include "downstream_perception/param_reader.h"
 
 namespace downstream_perception {
 
@@ -20,8 +21,12 @@ TrackedObstacleLayer::~TrackedObstacleLayer() {
 void TrackedObstacleLayer::onInitialize() {
   config_errors_.setPrefix("layer '" + name_ + "'");
   TrackInboxConfig inbox;
-  nh_.param("topic", inbox.topic, inbox.topic);
-  nh_.param("tf_queue_size", inbox.tf_queue_size, inbox.tf_queue_size);
+  ParamReader params(nh_, "layer '" + name_ + "'");
+  params.get("topic", &inbox.topic);
+  params.get("tf_queue_size", &inbox.tf_queue_size);
+  params.reconfigureKeys<TrackedObstacleLayerConfig>();
+  params.warnUnknown();
+  param_warnings_ = params.warnings();
   const std::string why = inbox.validate();
   if (!why.empty()) {
     config_errors_.add(why + "; using the defaults");
@@ -156,6 +161,7 @@ void TrackedObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   status.add("tracks drawn (last update)", tracks_drawn_);
   status.add("lethal cells drawn (last update)", cells_.size());
   status.add("prediction_horizon_s", prediction_.prediction_horizon_s);
+  addParamWarnings(status, param_warnings_);
   if (config_errors_.report(status)) return;  // ERROR, with the first problem
   if (!enabled_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "disabled");
@@ -167,6 +173,8 @@ void TrackedObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   } else if (!current_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    "tracks older than track_timeout_s: none drawn");
+  } else if (!param_warnings_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, param_warnings_.front());
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK,
                    "drawing " + std::to_string(tracks_drawn_) + " predicted tracks");

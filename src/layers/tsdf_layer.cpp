@@ -8,13 +8,17 @@
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/layered_costmap.h"
+#include "downstream_perception/param_reader.h"
 
 namespace downstream_perception {
 
 void TsdfLayer::onInitialize() {
-  nh_.param("topic", topic_, std::string("/tsdf/slice"));
-  nh_.param("max_age_s", max_age_s_, 0.0);
-  nh_.param("enabled", enabled_, true);
+  ParamReader params(nh_, "layer '" + name_ + "'");
+  topic_ = params.param<std::string>("topic", "/tsdf/slice");
+  max_age_s_ = params.param("max_age_s", 0.0);
+  enabled_ = params.param("enabled", true);
+  params.warnUnknown();
+  param_warnings_ = params.warnings();
   if (!(std::isfinite(max_age_s_) && max_age_s_ >= 0.0)) {
     config_errors_.push_back("parameter max_age_s = " + toText(max_age_s_) +
                              " must be >= 0 s (0 = any age); using 0");
@@ -122,9 +126,12 @@ void TsdfLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no TSDF slice received yet");
   } else if (!current_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "TSDF slice older than max_age_s");
+  } else if (!param_warnings_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, param_warnings_.front());
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "drawing the TSDF slice");
   }
+  addParamWarnings(status, param_warnings_);
 }
 
 }  // namespace downstream_perception

@@ -328,10 +328,7 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("clears (~clear)", clears_);
   status.add("clock jumps back", clock_jump_.jumps());
   addConfigErrors(status, errors);
-  status.add("parameter warnings", param_warnings_.size());
-  for (std::size_t k = 0; k < param_warnings_.size(); ++k) {
-    status.add("parameter warning " + toText(k + 1), param_warnings_[k]);
-  }
+  addParamWarnings(status, param_warnings_);
   status.add("footprint inscribed radius (m)", layered_costmap_->inscribedRadius());
   status.add("footprint circumscribed radius (m)", layered_costmap_->circumscribedRadius());
 }

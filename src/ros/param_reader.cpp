@@ -165,7 +165,26 @@ std::vector<std::string> ParamReader::warnUnknown() {
   return unknown;
 }
 
+void ParamReader::checkType(const std::string& key, const std::string& type) {
+  if (type == "double") {
+    double v = 0.0;
+    get(key, &v);
+  } else if (type == "int") {
+    int v = 0;
+    get(key, &v);
+  } else if (type == "bool") {
+    bool v = false;
+    get(key, &v);
+  } else {
+    std::string v;
+    get(key, &v);
+  }
+}
+
 void ParamReader::warn(const std::string& msg) {
+  for (const auto& earlier : warnings_) {
+    if (earlier == msg) return;  // a key read twice is named once
+  }
   ROS_WARN("%s: %s", who_.c_str(), msg.c_str());
   warnings_.push_back(msg);
 }

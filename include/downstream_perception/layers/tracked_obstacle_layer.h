@@ -53,6 +53,7 @@ class TrackedObstacleLayer : public Layer {
   std::size_t tracks_drawn_ = 0;
   bool subscribed_ = false;
   ConfigErrorLog config_errors_;
+  std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)
   std::unique_ptr<ReconfigureServer> reconfigure_server_;
   boost::recursive_mutex reconfigure_mutex_;
 };

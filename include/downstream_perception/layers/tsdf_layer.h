@@ -42,6 +42,7 @@ class TsdfLayer : public Layer {
   std::string last_rejection_;
   std::size_t lethal_written_ = 0;
   std::vector<std::string> config_errors_;
+  std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)
 };
 
 }  // namespace downstream_perception
