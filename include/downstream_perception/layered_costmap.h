@@ -2,6 +2,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -19,6 +20,18 @@ class LayeredCostmap {
 
   /// Resizes the master (every cell to the default value) and calls matchSize() on each layer.
   void resizeMap(const GridGeometry& geometry);
+  /// A layer (the static map) asks the master to take `geometry` and keep it: the size is then
+  /// locked (a reconfigure of width / height / resolution / origin no longer resizes), as
+  /// costmap_2d's resizeMap(..., size_locked = true). Resizes (under mutex(), calling every
+  /// layer's matchSize()) only if the geometry differs. A host that owns another master (the
+  /// costmap_2d adapter) installs a handler that resizes that one instead. Call it without
+  /// holding a layer's own lock: the resize calls back into every layer.
+  void lockSizeTo(const GridGeometry& geometry);
+  /// Whether a layer has fixed the master's geometry (see lockSizeTo()).
+  bool sizeLocked() const { return size_locked_; }
+  void setSizeLockHandler(std::function<void(const GridGeometry&)> handler) {
+    size_lock_handler_ = std::move(handler);
+  }
   void addPlugin(std::shared_ptr<Layer> plugin) { plugins_.push_back(std::move(plugin)); }
   const std::vector<std::shared_ptr<Layer>>& plugins() const { return plugins_; }
 
@@ -73,6 +86,8 @@ class LayeredCostmap {
   bool rolling_window_ = false;
   bool have_robot_pose_ = false;
   std::atomic<bool> full_redraw_{false};
+  std::atomic<bool> size_locked_{false};
+  std::function<void(const GridGeometry&)> size_lock_handler_;
 };
 
 }  // namespace downstream_perception

@@ -17,6 +17,7 @@
 #include "downstream_perception/core/inflation.h"
 #include "downstream_perception/core/log_odds_costs.h"
 #include "downstream_perception/core/scan_integrator.h"
+#include "downstream_perception/core/static_map.h"
 #include "downstream_perception/core/tracking/tracker.h"
 
 using namespace downstream_perception;  // NOLINT
@@ -414,11 +415,65 @@ void runTracker(int n, int frames) {
       n, frames, medianOf(us), p90Of(us), switches);
 }
 
+// The static layer: a map_server-sized map (4000 x 4000 cells, 200 m at 0.05 m: walls every 5 m,
+// an unknown border) mapped to costs, a 100 x 100 OccupancyGridUpdate applied, and the copies into
+// the master (whole map after a map, the window after an update).
+void runStaticMap(int iters) {
+  const int n = 4000, w = 100;
+  std::vector<std::int8_t> data(static_cast<std::size_t>(n) * n, 0);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      std::int8_t& v = data[static_cast<std::size_t>(y) * n + x];
+      if (x < 20 || y < 20 || x >= n - 20 || y >= n - 20) {
+        v = -1;
+      } else if (x % 100 == 0 || y % 100 == 0) {
+        v = 100;
+      }
+    }
+  }
+  std::vector<std::int8_t> update(static_cast<std::size_t>(w) * w, 100);
+  StaticMapInfo info;
+  info.width = n, info.height = n, info.resolution = 0.05, info.origin_x = -100.0;
+  info.origin_y = -100.0, info.data_size = data.size();
+  StaticMap map;
+  Costmap master(GridGeometry(n, n, 0.05, -100.0, -100.0), cost::kNoInformation);
+  std::vector<double> set_ms, update_us, copy_all_ms, copy_window_us;
+  const int map_reps = std::max(5, iters / 20);
+  for (int k = 0; k < map_reps; ++k) {
+    auto t0 = std::chrono::steady_clock::now();
+    if (!map.setMap(info, data.data()).empty()) std::abort();
+    set_ms.push_back(msSince(t0));
+    t0 = std::chrono::steady_clock::now();
+    copyStaticOverwrite(map.costs(), &master, 0, 0, n, n);
+    copy_all_ms.push_back(msSince(t0));
+  }
+  for (int k = 0; k < iters; ++k) {
+    const int x = (k * 137) % (n - w), y = (k * 311) % (n - w);
+    auto t0 = std::chrono::steady_clock::now();
+    if (!map.applyUpdate(x, y, w, w, update.data(), update.size()).empty()) std::abort();
+    update_us.push_back(msSince(t0) * 1000.0);
+    t0 = std::chrono::steady_clock::now();
+    copyStaticOverwrite(map.costs(), &master, x, y, x + w, y + w);
+    copy_window_us.push_back(msSince(t0) * 1000.0);
+  }
+  std::printf(
+      "{\"bench\": \"static_map\", \"cells\": %d, \"update_cells\": %d, "
+      "\"set_map_median_ms\": %.2f, \"copy_map_median_ms\": %.2f, "
+      "\"update_median_us\": %.2f, \"update_p90_us\": %.2f, \"copy_update_median_us\": %.2f, "
+      "\"lethal_cells\": %zu}\n",
+      n * n, w * w, medianOf(set_ms), medianOf(copy_all_ms), medianOf(update_us), p90Of(update_us),
+      medianOf(copy_window_us), map.counts().lethal);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int iters = 200;
   if (argc > 1) iters = std::max(10, std::atoi(argv[1]));
+  if (argc > 2 && std::strcmp(argv[2], "static") == 0) {  // the static-map rows only
+    runStaticMap(iters);
+    return 0;
+  }
   const int only_size = argc > 2 ? std::atoi(argv[2]) : 0;  // 0 = all map sizes
   for (int size : {200, 1000}) {
     if (only_size != 0 && size != only_size) continue;
@@ -444,5 +499,6 @@ int main(int argc, char** argv) {
   runCloud(std::max(10, iters / 10));
   runDecay(std::max(10, iters / 4));
   for (int n : {10, 50, 200}) runTracker(n, std::max(100, iters * 2));
+  runStaticMap(iters);
   return 0;
 }

@@ -8,6 +8,7 @@
 
 #include "downstream_perception/layers/inflation_layer.h"
 #include "downstream_perception/layers/log_odds_obstacle_layer.h"
+#include "downstream_perception/layers/static_layer.h"
 #include "downstream_perception/layers/tracked_obstacle_layer.h"
 #include "downstream_perception/layers/tsdf_layer.h"
 
@@ -40,6 +41,21 @@ void Costmap2dLayerAdapter::onInitialize() {
                                              layered_costmap_->isTrackingUnknown());
   const costmap_2d::Costmap2D& master = *layered_costmap_->getCostmap();
   if (hasCells(master)) shadow_->resizeMap(geometryOf(master));
+  shadow_->setRollingWindow(layered_costmap_->isRolling());
+  // A static map sizes costmap_2d's master (not only the shadow), locked against reconfigure as
+  // costmap_2d's StaticLayer does; every costmap_2d layer's matchSize() follows, ours included
+  // (which mirrors the new geometry into the shadow). Master lock first, then the shadow's: the
+  // order of costmap_2d's update thread.
+  shadow_->setSizeLockHandler([this](const GridGeometry& g) {
+    costmap_2d::Costmap2D* master_grid = layered_costmap_->getCostmap();
+    boost::unique_lock<costmap_2d::Costmap2D::mutex_t> lock(*master_grid->getMutex());
+    if (hasCells(*master_grid) && geometryOf(*master_grid) == g) return;
+    ROS_INFO("layer '%s': resizing the costmap to %d x %d cells at %.3f m", name_.c_str(),
+             g.sizeX(), g.sizeY(), g.resolution());
+    layered_costmap_->resizeMap(static_cast<unsigned int>(g.sizeX()),
+                                static_cast<unsigned int>(g.sizeY()), g.resolution(), g.originX(),
+                                g.originY(), true /* size_locked */);
+  });
   shadow_->addPlugin(impl_);
   onFootprintChanged();
   ros::NodeHandle private_nh("~");  // costmap_2d plugins read ~/<costmap>/<layer>/...
@@ -157,6 +173,12 @@ void Costmap2dLayerAdapter::onFootprintChanged() {
   if (validateFootprint(footprint).empty()) shadow_->setFootprint(footprint);
 }
 
+/// downstream_perception::StaticLayer (map_server's map) for costmap_2d / move_base.
+class Costmap2dStaticLayer : public Costmap2dLayerAdapter {
+ public:
+  Costmap2dStaticLayer() : Costmap2dLayerAdapter(std::make_shared<StaticLayer>()) {}
+};
+
 /// downstream_perception::LogOddsObstacleLayer for costmap_2d / move_base.
 class Costmap2dLogOddsObstacleLayer : public Costmap2dLayerAdapter {
  public:
@@ -185,6 +207,7 @@ class Costmap2dTrackedObstacleLayer : public Costmap2dLayerAdapter {
 
 }  // namespace downstream_perception
 
+PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dStaticLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dLogOddsObstacleLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dInflationLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dTsdfLayer, costmap_2d::Layer)

@@ -67,6 +67,8 @@ try:
         PredictionConfig,
         ScanIntegrator,
         ScanIntegratorConfig,
+        StaticMap,
+        StaticMapConfig,
         Tracker,
         TrackerConfig,
         TrackerStats,
@@ -99,6 +101,7 @@ try:
         shortest_angular_distance,
         slice_distance,
         solve_assignment,
+        static_map_values,
         swept_polygon,
         uncertainty_radius,
     )

@@ -18,6 +18,7 @@
 #include "downstream_perception/core/scan_integrator.h"
 #include "downstream_perception/core/se2.h"
 #include "downstream_perception/core/seam_health.h"
+#include "downstream_perception/core/static_map.h"
 #include "downstream_perception/core/tracking/assignment.h"
 #include "downstream_perception/core/tracking/box.h"
 #include "downstream_perception/core/tracking/kalman.h"
@@ -373,6 +374,85 @@ PYBIND11_MODULE(_core, m) {
         return out;
       },
       "cost (0..255) -> nav_msgs/OccupancyGrid value, costmap_2d's translation.");
+
+  // ----------------------------------------------------------------- static map
+  py::class_<StaticMapConfig>(m, "StaticMapConfig")
+      .def(py::init<>())
+      .def_readwrite("track_unknown_space", &StaticMapConfig::track_unknown_space)
+      .def_readwrite("use_maximum", &StaticMapConfig::use_maximum)
+      .def_readwrite("lethal_cost_threshold", &StaticMapConfig::lethal_cost_threshold,
+                     "occupancy value 0..100 (clamped) from which a cell is lethal")
+      .def_readwrite("unknown_cost_value", &StaticMapConfig::unknown_cost_value,
+                     "occupancy value meaning unknown, compared as a byte (-1 = 255)")
+      .def_readwrite("trinary_costmap", &StaticMapConfig::trinary_costmap)
+      .def_readwrite("max_cells", &StaticMapConfig::max_cells, "largest map accepted, cells");
+  m.def(
+      "static_map_values",
+      [](py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> occupancy,
+         const StaticMapConfig& config) {
+        const auto table = staticValueTable(config);
+        py::array_t<std::uint8_t> out(
+            std::vector<py::ssize_t>(occupancy.shape(), occupancy.shape() + occupancy.ndim()));
+        const std::int8_t* in = occupancy.data();
+        std::uint8_t* o = out.mutable_data();
+        for (py::ssize_t k = 0; k < occupancy.size(); ++k) {
+          o[k] = table[static_cast<std::uint8_t>(in[k])];
+        }
+        return out;
+      },
+      py::arg("occupancy"), py::arg("config") = StaticMapConfig(),
+      "nav_msgs/OccupancyGrid values (int8, any shape) -> costs, costmap_2d's StaticLayer "
+      "mapping.");
+  py::class_<StaticMap>(m, "StaticMap")
+      .def(py::init<const StaticMapConfig&>(), py::arg("config") = StaticMapConfig())
+      .def(
+          "set_map",
+          [](StaticMap& self,
+             py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> data,
+             double resolution, double origin_x, double origin_y) {
+            if (data.ndim() != 2) throw std::invalid_argument("data must be a 2-D [y, x] array");
+            StaticMapInfo info;
+            info.height = data.shape(0), info.width = data.shape(1);
+            info.resolution = resolution, info.origin_x = origin_x, info.origin_y = origin_y;
+            info.data_size = static_cast<std::size_t>(data.size());
+            const std::string why = self.setMap(info, data.data());
+            if (!why.empty()) throw std::invalid_argument(why);
+          },
+          py::arg("data"), py::arg("resolution"), py::arg("origin_x") = 0.0,
+          py::arg("origin_y") = 0.0,
+          "Replaces the map ([y, x] int8 occupancy); ValueError (map kept) if it is refused.")
+      .def(
+          "apply_update",
+          [](StaticMap& self, std::int64_t x, std::int64_t y,
+             py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> data) {
+            if (data.ndim() != 2) throw std::invalid_argument("data must be a 2-D [y, x] array");
+            const std::string why =
+                self.applyUpdate(x, y, data.shape(1), data.shape(0), data.data(),
+                                 static_cast<std::size_t>(data.size()));
+            if (!why.empty()) throw std::invalid_argument(why);
+          },
+          py::arg("x"), py::arg("y"), py::arg("data"),
+          "map_msgs/OccupancyGridUpdate: rewrites [x, x + w) x [y, y + h); ValueError (nothing "
+          "written) if the window is not inside the map.")
+      .def_property_readonly("has_map", &StaticMap::hasMap)
+      .def_property_readonly("geometry",
+                             [](const StaticMap& self) { return self.costs().geometry(); })
+      .def(
+          "costs",
+          [](const StaticMap& self) {
+            const GridGeometry& g = self.costs().geometry();
+            py::array_t<std::uint8_t> out({g.sizeY(), g.sizeX()});
+            std::copy(self.costs().cells().begin(), self.costs().cells().end(), out.mutable_data());
+            return out;
+          },
+          "[y, x] uint8 costs.")
+      .def_property_readonly(
+          "last_change",
+          [](const StaticMap& self) {
+            const CellBounds& b = self.lastChange();
+            return py::make_tuple(b.min_x, b.min_y, b.max_x, b.max_y);
+          },
+          "(min_x, min_y, max_x, max_y) cells, inclusive; min > max if nothing changed");
 
   // ----------------------------------------------------------------- inflation
   py::class_<InflationConfig>(m, "InflationConfig")

@@ -128,7 +128,12 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
                       next.sizeYCells() != config_.sizeYCells() ||
                       next.resolution != config_.resolution || next.origin_x != config_.origin_x ||
                       next.origin_y != config_.origin_y;
-  if (resize) {
+  if (resize && layered_costmap_->sizeLocked()) {
+    // A static map fixed the geometry (costmap_2d's size_locked): the map's size wins.
+    ROS_WARN(
+        "costmap: width / height / resolution / origin not applied: the static map sets the "
+        "costmap's size");
+  } else if (resize) {
     std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
     // A rolling window keeps its current (robot-centred) origin; the next update re-centres.
     const GridGeometry& g = layered_costmap_->costmap().geometry();

@@ -17,6 +17,16 @@ void LayeredCostmap::resizeMap(const GridGeometry& geometry) {
   full_redraw_ = true;
 }
 
+void LayeredCostmap::lockSizeTo(const GridGeometry& geometry) {
+  if (size_lock_handler_) {
+    size_lock_handler_(geometry);  // takes its master's lock first, then ours (via matchSize)
+    return;
+  }
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  size_locked_ = true;
+  if (master_.geometry() != geometry) resizeMap(geometry);
+}
+
 CellBounds LayeredCostmap::updateMap(double robot_x, double robot_y, double robot_yaw,
                                      bool have_robot_pose) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
