@@ -8,6 +8,7 @@
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace downstream_perception {
@@ -40,6 +41,10 @@ inline void addParamWarnings(diagnostic_updater::DiagnosticStatusWrapper& status
 /// The parameter problems of one component (a layer, a nodelet): each logged once as an error
 /// with the component's prefix and kept for its diagnostics. Safe from any thread (start-up,
 /// dynamic_reconfigure callbacks, the diagnostics timer).
+///
+/// add() keeps a problem for the component's lifetime (a start-up value that cannot change).
+/// set(key, ...) keeps at most one problem per key (a dynamic_reconfigure parameter or group) and
+/// clear(key) drops it: a later reconfigure that fixes the value removes the error.
 class ConfigErrorLog {
  public:
   void setPrefix(std::string prefix) { prefix_ = std::move(prefix); }
@@ -48,9 +53,34 @@ class ConfigErrorLog {
     std::lock_guard<std::mutex> lock(mutex_);
     errors_.push_back(msg);
   }
+  /// The current problem of `key`, replacing the previous one (logged as an error).
+  void set(const std::string& key, const std::string& msg) {
+    ROS_ERROR("%s: %s", prefix_.c_str(), msg.c_str());
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& entry : keyed_) {
+      if (entry.first == key) {
+        entry.second = msg;
+        return;
+      }
+    }
+    keyed_.emplace_back(key, msg);
+  }
+  /// `key` is fine now: its problem (if any) leaves the diagnostics.
+  void clear(const std::string& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = keyed_.begin(); it != keyed_.end(); ++it) {
+      if (it->first == key) {
+        keyed_.erase(it);
+        return;
+      }
+    }
+  }
+  /// Every current problem: the lasting ones first, then the keyed ones in the order they arose.
   std::vector<std::string> all() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return errors_;
+    std::vector<std::string> out = errors_;
+    for (const auto& entry : keyed_) out.push_back(entry.second);
+    return out;
   }
   /// The count and every message into the status; if any, an ERROR summary with the first one.
   /// Returns whether there was any.
@@ -66,6 +96,7 @@ class ConfigErrorLog {
   std::string prefix_ = "config";
   mutable std::mutex mutex_;
   std::vector<std::string> errors_;
+  std::vector<std::pair<std::string, std::string>> keyed_;  ///< key -> its current problem
 };
 
 }  // namespace downstream_perception

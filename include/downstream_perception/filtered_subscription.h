@@ -76,6 +76,13 @@ class FilteredSubscription {
     subscriber_.reset();
     monitor_.clear();
   }
+  bool subscribed() const { return subscriber_ != nullptr; }
+  /// The resolved topic name ("" before subscribe()).
+  std::string topic() const { return subscriber_ ? subscriber_->getSubscriber().getTopic() : ""; }
+  /// Publishers currently connected to the topic (0 before subscribe()).
+  std::uint32_t numPublishers() const {
+    return subscriber_ ? subscriber_->getSubscriber().getNumPublishers() : 0;
+  }
   /// Also wait for transforms up to `tolerance` after the stamp (a scan's last beam).
   void setTolerance(const ros::Duration& tolerance) {
     if (filter_) filter_->setTolerance(tolerance);

@@ -66,6 +66,10 @@ class Layer {
 
   /// False while the layer's inputs are missing or stale.
   bool isCurrent() const { return current_; }
+  /// "" while current, else why not (for the host's WARN): a layer with inputs names them.
+  virtual std::string notCurrentReason() const {
+    return current_ ? std::string() : "layer '" + name_ + "' is not current";
+  }
   bool isEnabled() const { return enabled_; }
   const std::string& name() const { return name_; }
 

@@ -19,24 +19,44 @@ void InflationLayer::onInitialize() {
 }
 
 void InflationLayer::reconfigure(InflationLayerConfig& cfg, std::uint32_t) {
-  InflationConfig candidate = config_;
-  candidate.inflation_radius = cfg.inflation_radius;
-  candidate.cost_scaling_factor = cfg.cost_scaling_factor;
-  candidate.inflate_unknown = cfg.inflate_unknown;
-  applyConfig(candidate);
+  config_errors_.setPrefix("layer '" + name_ + "'");
+  InflationConfig candidate;
+  bool changed = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    candidate = config_;
+    candidate.inflation_radius = cfg.inflation_radius;
+    candidate.cost_scaling_factor = cfg.cost_scaling_factor;
+    candidate.inflate_unknown = cfg.inflate_unknown;
+    changed = !inflator_ || candidate.inflation_radius != config_.inflation_radius ||
+              candidate.cost_scaling_factor != config_.cost_scaling_factor ||
+              candidate.inflate_unknown != config_.inflate_unknown;
+  }
+  // Unchanged values are not validated again: a kept error stays until a request fixes it.
+  if (changed && !applyConfig(candidate, "parameters")) {
+    // The server stores and publishes what the callback leaves in `cfg`: the values in use, so
+    // a later change of another key does not send the rejected ones again.
+    std::lock_guard<std::mutex> lock(mutex_);
+    cfg.inflation_radius = config_.inflation_radius;
+    cfg.cost_scaling_factor = config_.cost_scaling_factor;
+    cfg.inflate_unknown = config_.inflate_unknown;
+  }
   if (cfg.enabled != enabled_) {
     enabled_ = cfg.enabled;
     layered_costmap_->requestFullRedraw();  // its costs appear or vanish everywhere
   }
 }
 
-void InflationLayer::applyConfig(InflationConfig candidate) {
+bool InflationLayer::applyConfig(InflationConfig candidate, const std::string& error_key) {
   std::lock_guard<std::mutex> lock(mutex_);
   candidate.inscribed_radius = layered_costmap_->inscribedRadius();
   const double map_resolution = layered_costmap_->costmap().geometry().resolution();
   const double resolution = map_resolution > 0.0 ? map_resolution : 0.05;
   const std::string why = candidate.validate(resolution);
-  if (!why.empty()) {
+  const bool accepted = why.empty();
+  if (accepted) {
+    config_errors_.clear(error_key);
+  } else {
     std::string msg = "parameters invalid (" + why + "); keeping inflation_radius " +
                       std::to_string(config_.inflation_radius) + " m, cost_scaling_factor " +
                       std::to_string(config_.cost_scaling_factor) + " 1/m";
@@ -49,8 +69,7 @@ void InflationLayer::applyConfig(InflationConfig candidate) {
       msg += " capped to " + std::to_string(candidate.inflation_radius) + " m (" +
              std::to_string(InflationConfig::kMaxRadiusCells) + " cells)";
     }
-    ROS_ERROR("layer '%s': %s", name_.c_str(), msg.c_str());
-    config_errors_.push_back(msg);
+    config_errors_.set(error_key, msg);
   }
   if (candidate.inflation_radius < candidate.inscribed_radius) {
     // Allowed (costmap_2d accepts it) but the robot would touch walls the planner thinks clear.
@@ -67,6 +86,7 @@ void InflationLayer::applyConfig(InflationConfig candidate) {
       "inscribed radius %.3f m",
       name_.c_str(), config_.inflation_radius, inflator_->radiusCells(),
       config_.cost_scaling_factor, config_.inscribed_radius);
+  return accepted;
 }
 
 void InflationLayer::updateBounds(double, double, double, double* min_x, double* min_y,
@@ -106,7 +126,7 @@ void InflationLayer::updateCosts(Costmap& master, int min_i, int min_j, int max_
 
 void InflationLayer::matchSize() {
   // The Inflator follows the master's geometry by itself; a new resolution needs a new table.
-  if (inflator_) applyConfig(config_);
+  if (inflator_) applyConfig(config_, "resolution");
 }
 
 void InflationLayer::shiftOrigin(int dx, int dy) {
@@ -122,16 +142,12 @@ void InflationLayer::reset() {
 }
 
 void InflationLayer::onFootprintChanged() {
-  if (inflator_) applyConfig(config_);
+  if (inflator_) applyConfig(config_, "footprint");
 }
 
 void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "inflating");
-  }
+  status.summary(diagnostic_msgs::DiagnosticStatus::OK, "inflating");
   status.add("inflation radius (m)", config_.inflation_radius);
   status.add("inflation radius (cells)", inflator_ ? inflator_->radiusCells() : 0);
   status.add("cost scaling factor (1/m)", config_.cost_scaling_factor);
@@ -143,7 +159,7 @@ void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("last update: lethal cells changed", last_.lethal_changed);
   status.add("last update: cells re-inflated", last_.cells_recomputed);
   status.add("last update: cells merged", last_.cells_merged);
-  addConfigErrors(status, config_errors_);
+  config_errors_.report(status);  // ERROR with the first problem, if any
 }
 
 }  // namespace downstream_perception

@@ -5,6 +5,7 @@
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -22,6 +23,7 @@ LaserScanSource::LaserScanSource(std::string name, const ObservationSourceConfig
                         std::move(on_observation)) {}
 
 void LaserScanSource::subscribe() {
+  if (subscription_.subscribed()) return;  // activate() runs at every reconfigure
   subscription_.subscribe(
       nh_, config_.topic, tf_, global_frame_, config_.tf_queue_size,
       [this](const sensor_msgs::LaserScanConstPtr& msg) { onScan(msg); },
@@ -30,10 +32,12 @@ void LaserScanSource::subscribe() {
         onTfFailure(msg->header.frame_id, msg->header.stamp, reason);
       });
   subscription_.setTolerance(tolerance_);
+  markSubscribed();
 }
 
 bool LaserScanSource::sensorPose(const std::string& frame, const ros::Time& stamp,
-                                 bool reject_on_failure, Pose2D* pose, bool* upside_down) {
+                                 bool reject_on_failure, Pose2D* pose, bool* upside_down,
+                                 ScanHeightModel* heights) {
   geometry_msgs::TransformStamped t;
   if (!lookup(frame, stamp, &t, reject_on_failure)) return false;
   const auto& q = t.transform.rotation;
@@ -51,6 +55,11 @@ bool LaserScanSource::sensorPose(const std::string& frame, const ros::Time& stam
   pose->y = t.transform.translation.y;
   pose->yaw = std::atan2(r[1][0], r[0][0]);
   *upside_down = r[2][2] < 0.0;
+  if (heights != nullptr) {
+    heights->origin_z = t.transform.translation.z;
+    heights->zx = r[2][0];
+    heights->zy = r[2][1];
+  }
   return true;
 }
 
@@ -67,12 +76,22 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
     return;
   }
 
-  LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
-                     msg->angle_increment, msg->range_min,     msg->range_max};
   const std::string& frame = frameOf(msg->header.frame_id);
   Pose2D first;
   bool upside_down = false;
-  if (!sensorPose(frame, msg->header.stamp, true, &first, &upside_down)) return;
+  ScanHeightModel heights;
+  if (!sensorPose(frame, msg->header.stamp, true, &first, &upside_down, &heights)) return;
+  // costmap_2d's rules on a copy of the ranges: the height band (every beam's end, global z) and
+  // its inf_is_valid substitution. Beams set to NaN here are counted as outside the band.
+  ranges_.assign(msg->ranges.begin(), msg->ranges.end());
+  const CloudBeamsConfig band = heightBand();
+  const ScanPrefilterStats filtered = prefilterScanRanges(
+      &ranges_, msg->angle_min, msg->angle_increment, msg->range_max,
+      config_.costmap2d_inf_is_valid,
+      std::min<double>(msg->range_max, config_.integrator.raytrace_max_range), heights,
+      ScanHeightBand{band.min_obstacle_height, band.max_obstacle_height});
+  LaserScanView view{ranges_.data(),       ranges_.size(), msg->angle_min,
+                     msg->angle_increment, msg->range_min, msg->range_max};
   if (upside_down) {
     // Upside-down scanner: beam angles run clockwise in the global frame.
     view.angle_min = -view.angle_min;
@@ -101,6 +120,8 @@ void LaserScanSource::onScan(const sensor_msgs::LaserScanConstPtr& msg) {
     }
   }
   if (!corrected) integrator_.beamsFromScan(view, first, &obs.beams, &obs.decisions);
+  obs.decisions.beams_invalid -= std::min(obs.decisions.beams_invalid, filtered.outside_band);
+  obs.decisions.points_outside_height += filtered.outside_band;
   on_observation_(*this, obs);
 }
 

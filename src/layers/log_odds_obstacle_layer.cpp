@@ -2,6 +2,7 @@
 
 #include <pluginlib/class_list_macros.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -22,6 +23,10 @@ constexpr double kMinDecayPeriodS = 0.1;
 constexpr double kClearingSensorLatencyS = 0.1;
 // ... and never further back than this (the first clearing, a long pause).
 constexpr double kMaxClearingLookbackS = 1.0;
+// A subscribed topic with no publisher after this long is named (a publisher may start late).
+constexpr double kNoPublisherGraceS = 5.0;
+// A silent source or a topic without a publisher is logged at most this often, per source.
+constexpr double kSourceWarnPeriodS = 10.0;
 }  // namespace
 
 LogOddsObstacleLayer::~LogOddsObstacleLayer() {
@@ -33,15 +38,47 @@ LogOddsObstacleLayer::~LogOddsObstacleLayer() {
 
 void LogOddsObstacleLayer::onInitialize() {
   config_errors_.setPrefix("layer '" + name_ + "'");
-  nh_.param("track_unknown_space", track_unknown_space_, layered_costmap_->isTrackingUnknown());
+  ParamReader reader(nh_, "layer '" + name_ + "'");
+  // costmap_2d's ObstacleLayer keys, in its lookup order, with its defaults.
+  track_unknown_space_ = layered_costmap_->isTrackingUnknown();
+  reader.get("track_unknown_space", &track_unknown_space_);
+  double transform_tolerance = 0.2;
+  reader.get("transform_tolerance", &transform_tolerance);
+  if (!std::isfinite(transform_tolerance) || transform_tolerance < 0.0) {
+    config_errors_.add("transform_tolerance must be finite and >= 0 s, got " +
+                       std::to_string(transform_tolerance));
+  }
+  std::string names;
+  reader.get("observation_sources", &names);
+  // The dynamic_reconfigure keys: type-checked here (the server drops a wrong-typed value without
+  // a word), read by the server below.
+  for (const char* key : {"enabled", "footprint_clearing_enabled", "clear_tracked_objects"}) {
+    bool unused = false;
+    reader.get(key, &unused);
+  }
+  for (const char* key :
+       {"p_hit", "p_miss", "log_odds_min", "log_odds_max", "occupied_log_odds", "free_log_odds",
+        "tracked_clearing_margin_m", "max_obstacle_height", "decay_time_s"}) {
+    double unused = 0.0;
+    reader.get(key, &unused);
+  }
+  int combination = 0;
+  reader.get("combination_method", &combination);
+  // Found from each source by searchParam (costmap_2d's lookup), so they may sit here.
+  reader.known({"obstacle_range", "raytrace_range"});
   grid_ = LogOddsGrid(layered_costmap_->costmap().geometry(), grid_config_);
-  readSources();
+  readSources(names);
+  {
+    std::istringstream stream(names);
+    std::string name;
+    while (stream >> name) reader.known({name});  // each source's own namespace
+  }
   TrackInboxConfig tracks;
   tracks.include_tentative = false;  // only confirmed tracks: a tentative one may be clutter and
   tracks.include_coasting = false;   // a coasting one is not where the sensor sees its returns
-  nh_.param("tracks_topic", tracks.topic, tracks.topic);
-  nh_.param("track_timeout_s", tracks.track_timeout_s, tracks.track_timeout_s);
-  nh_.param("tracks_tf_queue_size", tracks.tf_queue_size, tracks.tf_queue_size);
+  reader.get("tracks_topic", &tracks.topic);
+  reader.get("track_timeout_s", &tracks.track_timeout_s);
+  reader.get("tracks_tf_queue_size", &tracks.tf_queue_size);
   const std::string why = tracks.validate();
   if (!why.empty()) {
     config_errors_.add("tracks for clear_tracked_objects: " + why + "; using the defaults");
@@ -49,6 +86,12 @@ void LogOddsObstacleLayer::onInitialize() {
     tracks.include_coasting = false;
   }
   track_inbox_.setConfig(tracks);
+  readLayerParams(reader);
+  reader.warnUnknown();
+  {
+    std::lock_guard<std::mutex> lock(param_warnings_mutex_);
+    for (const auto& w : reader.warnings()) param_warnings_.push_back(w);
+  }
   // The server reads the YAML values (or the .cfg defaults, equal to the C++ ones) and calls
   // reconfigure() once at once: one code path for start-up and live changes.
   reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
@@ -56,7 +99,17 @@ void LogOddsObstacleLayer::onInitialize() {
                                                boost::placeholders::_1, boost::placeholders::_2));
 }
 
+void LogOddsObstacleLayer::warnParam(const std::string& msg) {
+  ROS_WARN("layer '%s': %s", name_.c_str(), msg.c_str());
+  std::lock_guard<std::mutex> lock(param_warnings_mutex_);
+  param_warnings_.push_back(msg);
+}
+
 void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uint32_t) {
+  // Each key (or the sensor model as a group) is validated when the request changes it. A
+  // rejected value is written back into `cfg`: the server stores and publishes what the callback
+  // leaves there, so it shows the value in use and a later change of another key does not send
+  // the rejected one again. Its error stays in diagnostics until a request sets a valid value.
   LogOddsConfig model;
   model.p_hit = cfg.p_hit;
   model.p_miss = cfg.p_miss;
@@ -64,38 +117,62 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   model.clamp_max = cfg.log_odds_max;
   model.occupied_threshold = cfg.occupied_log_odds;
   model.free_threshold = cfg.free_log_odds;
-  std::string why = model.validate();
-  if (!why.empty()) {
-    config_errors_.add("sensor model invalid (" + why + "); keeping p_hit " +
-                       std::to_string(grid_config_.p_hit) + ", p_miss " +
-                       std::to_string(grid_config_.p_miss) + " and the previous limits");
-    model = grid_config_;
+  if (model != grid_config_) {
+    const std::string why = model.validate();
+    if (why.empty()) {
+      config_errors_.clear("sensor model");
+    } else {
+      config_errors_.set("sensor model", "sensor model invalid (" + why + "); keeping p_hit " +
+                                             std::to_string(grid_config_.p_hit) + ", p_miss " +
+                                             std::to_string(grid_config_.p_miss) +
+                                             " and the previous limits");
+      model = grid_config_;
+      cfg.p_hit = model.p_hit;
+      cfg.p_miss = model.p_miss;
+      cfg.log_odds_min = model.clamp_min;
+      cfg.log_odds_max = model.clamp_max;
+      cfg.occupied_log_odds = model.occupied_threshold;
+      cfg.free_log_odds = model.free_threshold;
+    }
   }
   ObstacleLayerConfig layer = config_;
-  why = validateCombinationMethod(cfg.combination_method);
-  if (why.empty()) {
-    layer.combination_method = static_cast<CombinationMethod>(cfg.combination_method);
-  } else {
-    config_errors_.add(why + "; keeping " +
-                       std::to_string(static_cast<int>(config_.combination_method)));
+  if (cfg.combination_method != static_cast<int>(config_.combination_method)) {
+    const std::string why = validateCombinationMethod(cfg.combination_method);
+    if (why.empty()) {
+      layer.combination_method = static_cast<CombinationMethod>(cfg.combination_method);
+      config_errors_.clear("combination_method");
+    } else {
+      config_errors_.set(
+          "combination_method",
+          why + "; keeping " + std::to_string(static_cast<int>(config_.combination_method)));
+      cfg.combination_method = static_cast<int>(config_.combination_method);
+    }
   }
-  if (std::isfinite(cfg.decay_time_s) && cfg.decay_time_s >= 0.0) {
-    layer.decay_time_s = cfg.decay_time_s;
-  } else {
-    config_errors_.add("decay_time_s must be finite and >= 0 s (0 = off), got " +
-                       std::to_string(cfg.decay_time_s) + "; keeping " +
-                       std::to_string(config_.decay_time_s));
-  }
+  const auto check = [this](const char* key, double* requested, double in_use, bool valid,
+                            const std::string& rule, double* target) {
+    if (*requested == in_use) return;  // unchanged: a kept error stays
+    if (valid) {
+      *target = *requested;
+      config_errors_.clear(key);
+      return;
+    }
+    config_errors_.set(key, std::string(key) + " " + rule + ", got " + std::to_string(*requested) +
+                                "; keeping " + std::to_string(in_use));
+    *requested = in_use;
+  };
+  check("decay_time_s", &cfg.decay_time_s, config_.decay_time_s,
+        std::isfinite(cfg.decay_time_s) && cfg.decay_time_s >= 0.0,
+        "must be finite and >= 0 s (0 = off)", &layer.decay_time_s);
+  check("tracked_clearing_margin_m", &cfg.tracked_clearing_margin_m,
+        config_.tracked_clearing_margin_m,
+        std::isfinite(cfg.tracked_clearing_margin_m) && cfg.tracked_clearing_margin_m >= 0.0 &&
+            cfg.tracked_clearing_margin_m <= 2.0,
+        "must be in [0, 2] m", &layer.tracked_clearing_margin_m);
+  check("max_obstacle_height", &cfg.max_obstacle_height, config_.max_obstacle_height,
+        std::isfinite(cfg.max_obstacle_height), "must be finite (m)", &layer.max_obstacle_height);
   layer.footprint_clearing_enabled = cfg.footprint_clearing_enabled;
   layer.clear_tracked_objects = cfg.clear_tracked_objects;
-  if (std::isfinite(cfg.tracked_clearing_margin_m) && cfg.tracked_clearing_margin_m >= 0.0 &&
-      cfg.tracked_clearing_margin_m <= 2.0) {
-    layer.tracked_clearing_margin_m = cfg.tracked_clearing_margin_m;
-  } else {
-    config_errors_.add("tracked_clearing_margin_m must be in [0, 2] m, got " +
-                       std::to_string(cfg.tracked_clearing_margin_m) + "; keeping " +
-                       std::to_string(config_.tracked_clearing_margin_m));
-  }
+  applyMarkLimit(layer.max_obstacle_height);
   {
     std::lock_guard<std::mutex> lock(grid_mutex_);
     grid_config_ = model;
@@ -119,11 +196,12 @@ void LogOddsObstacleLayer::reconfigure(LogOddsObstacleLayerConfig& cfg, std::uin
   if (was_enabled != enabled_) layered_costmap_->requestFullRedraw();
   ROS_INFO(
       "layer '%s': p_hit %.3f p_miss %.3f, log-odds in [%.2f, %.2f], occupied > %.2f, "
-      "free < %.2f, combination %d, footprint clearing %s, decay time %.2f s, tracked-object "
-      "clearing %s, %s",
+      "free < %.2f, combination %d, footprint clearing %s, max_obstacle_height %.2f m, decay "
+      "time %.2f s, tracked-object clearing %s, %s",
       name_.c_str(), model.p_hit, model.p_miss, model.clamp_min, model.clamp_max,
       model.occupied_threshold, model.free_threshold, static_cast<int>(layer.combination_method),
-      layer.footprint_clearing_enabled ? "on" : "off", layer.decay_time_s,
+      layer.footprint_clearing_enabled ? "on" : "off", layer.max_obstacle_height,
+      layer.decay_time_s,
       layer.clear_tracked_objects ? ("on (" + track_inbox_.config().topic + ", margin " +
                                      std::to_string(layer.tracked_clearing_margin_m) + " m)")
                                         .c_str()
@@ -140,8 +218,14 @@ std::string LogOddsObstacleLayer::readCostmap2dRanges(const ros::NodeHandle& sou
   std::string from;
   const auto take = [&](const char* theirs, const char* ours, double* value) {
     std::string key;
+    XmlRpc::XmlRpcValue raw;
+    if (!source_nh.searchParam(theirs, key) || !source_nh.getParam(key, raw)) return;
     double v = 0.0;
-    if (!source_nh.searchParam(theirs, key) || !source_nh.getParam(key, v)) return;
+    const std::string wrong = convertParam(raw, &v);
+    if (!wrong.empty()) {
+      warnParam("source '" + source + "': parameter " + key + " " + wrong + "; ignored");
+      return;
+    }
     if (source_nh.hasParam(ours)) {
       if (v != *value) {
         ROS_WARN("layer '%s', source '%s': both %s (%s = %.3f) and %s (%.3f) are set; using %s",
@@ -157,44 +241,82 @@ std::string LogOddsObstacleLayer::readCostmap2dRanges(const ros::NodeHandle& sou
   return from;
 }
 
-void LogOddsObstacleLayer::readSources() {
-  std::string names;
-  nh_.param("observation_sources", names, std::string());
+void LogOddsObstacleLayer::readSources(const std::string& names) {
   std::istringstream stream(names);
   std::string name;
   while (stream >> name) {
     ros::NodeHandle snh(nh_, name);
+    ParamReader reader(snh, "layer '" + name_ + "', source '" + name + "'");
     ObservationSourceConfig config;
-    std::string data_type;
-    snh.param("data_type", data_type, std::string("LaserScan"));
-    if (data_type != "LaserScan" && data_type != "PointCloud2") {
+    ScanIntegratorConfig& ic = config.integrator;
+    // costmap_2d's keys, in its lookup order, with its defaults.
+    config.topic = name;
+    reader.get("topic", &config.topic);
+    reader.get("sensor_frame", &config.sensor_frame);
+    reader.get("observation_persistence", &config.observation_persistence);
+    reader.get("expected_update_rate", &config.expected_update_rate);
+    std::string data_type = "PointCloud";
+    reader.get("data_type", &data_type);
+    config.cloud.min_obstacle_height = 0.0;
+    config.cloud.max_obstacle_height = 2.0;
+    reader.get("min_obstacle_height", &config.cloud.min_obstacle_height);
+    reader.get("max_obstacle_height", &config.cloud.max_obstacle_height);
+    bool inf_is_valid = false;
+    reader.get("inf_is_valid", &inf_is_valid);
+    ic.clearing = false;
+    ic.marking = true;
+    reader.get("clearing", &ic.clearing);
+    reader.get("marking", &ic.marking);
+    // Ours (see README): finer ranges, REP-117 no-return clearing, tf queue, de-skew.
+    ic.inf_is_valid = false;
+    reader.get("inf_is_no_return", &ic.inf_is_valid);
+    reader.get("range_max_is_no_return", &ic.range_max_is_no_return);
+    reader.get("tf_queue_size", &config.tf_queue_size);
+    reader.get("per_beam_time_correction", &config.per_beam_time_correction);
+    reader.get("obstacle_min_range", &ic.obstacle_min_range);
+    reader.get("obstacle_max_range", &ic.obstacle_max_range);
+    reader.get("raytrace_min_range", &ic.raytrace_min_range);
+    reader.get("raytrace_max_range", &ic.raytrace_max_range);
+    reader.known({"obstacle_range", "raytrace_range"});
+    const std::string ranges_from = readCostmap2dRanges(snh, name, &ic);
+    reader.warnUnknown();
+    {
+      std::lock_guard<std::mutex> lock(param_warnings_mutex_);
+      for (const auto& w : reader.warnings())
+        param_warnings_.push_back("source '" + name + "': " + w);
+    }
+    if (data_type != "LaserScan" && data_type != "PointCloud" && data_type != "PointCloud2") {
       config_errors_.add("source '" + name + "': data_type '" + data_type +
-                         "' is not supported (LaserScan or PointCloud2); source ignored");
+                         "' is not supported (LaserScan, PointCloud or PointCloud2); source "
+                         "ignored");
       continue;
     }
-    snh.param("topic", config.topic, name);
-    snh.param("sensor_frame", config.sensor_frame, std::string());
-    snh.param("expected_update_rate", config.expected_update_rate, 0.0);
-    snh.param("tf_queue_size", config.tf_queue_size, 20);
-    snh.param("per_beam_time_correction", config.per_beam_time_correction, true);
-    snh.param("min_obstacle_height", config.cloud.min_obstacle_height,
-              CloudBeamsConfig{}.min_obstacle_height);
-    snh.param("max_obstacle_height", config.cloud.max_obstacle_height,
-              CloudBeamsConfig{}.max_obstacle_height);
-    ScanIntegratorConfig& ic = config.integrator;
-    const ScanIntegratorConfig d;
-    snh.param("marking", ic.marking, d.marking);
-    snh.param("clearing", ic.clearing, d.clearing);
-    snh.param("obstacle_min_range", ic.obstacle_min_range, d.obstacle_min_range);
-    snh.param("obstacle_max_range", ic.obstacle_max_range, d.obstacle_max_range);
-    snh.param("raytrace_min_range", ic.raytrace_min_range, d.raytrace_min_range);
-    snh.param("raytrace_max_range", ic.raytrace_max_range, d.raytrace_max_range);
-    const std::string ranges_from = readCostmap2dRanges(snh, name, &ic);
-    snh.param("inf_is_valid", ic.inf_is_valid, d.inf_is_valid);
-    snh.param("range_max_is_no_return", ic.range_max_is_no_return, d.range_max_is_no_return);
-    // One beam per grid cell of a cloud: the same cells, a fraction of the ray walks.
-    config.cloud.merge_cell_m = layered_costmap_->costmap().geometry().resolution();
-    std::string why = ic.validate();
+    const bool is_scan = data_type == "LaserScan";
+    if (inf_is_valid && !is_scan) {
+      warnParam("source '" + name + "': inf_is_valid does not apply to " + data_type +
+                " observations (as in costmap_2d); ignored");
+    } else if (inf_is_valid && ic.inf_is_valid) {
+      warnParam("source '" + name +
+                "': inf_is_valid and inf_is_no_return are both true; using "
+                "inf_is_no_return (+Inf clears up to raytrace range and marks nothing)");
+    } else if (inf_is_valid) {
+      config.costmap2d_inf_is_valid = true;  // costmap_2d's meaning: a return at range_max
+    }
+    if (config.observation_persistence > 0.0) {
+      warnParam("source '" + name + "': observation_persistence " +
+                std::to_string(config.observation_persistence) +
+                " s differs from costmap_2d: there each observation of the last " +
+                "observation_persistence seconds is marked again at every update (a mark "
+                "outlives later clearing that long); here each observation is integrated once "
+                "(integrating the same measurement again would count it many times over) and its "
+                "evidence lasts until later misses outweigh it (see decay_time_s)");
+    }
+    std::string why;
+    if (!std::isfinite(config.expected_update_rate) || config.expected_update_rate < 0.0) {
+      why = "expected_update_rate must be finite and >= 0 s (0 = off), got " +
+            std::to_string(config.expected_update_rate);
+    }
+    if (why.empty()) why = ic.validate();
     if (why.empty()) why = config.cloud.validate();
     if (config.tf_queue_size < 1 || config.tf_queue_size > 10000) {
       why = "tf_queue_size must be in [1, 10000], got " + std::to_string(config.tf_queue_size);
@@ -203,28 +325,54 @@ void LogOddsObstacleLayer::readSources() {
       config_errors_.add("source '" + name + "': " + why + "; source ignored");
       continue;
     }
+    // One beam per grid cell of a cloud: the same cells, a fraction of the ray walks.
+    config.cloud.merge_cell_m = layered_costmap_->costmap().geometry().resolution();
     auto on_observation = [this](ObservationSource& source, const Observation& observation) {
       integrate(source, observation);
     };
-    if (data_type == "LaserScan") {
+    if (is_scan) {
       sources_.push_back(std::make_unique<LaserScanSource>(
           name, config, topic_nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
     } else {
       sources_.push_back(std::make_unique<PointCloudSource>(
-          name, config, topic_nh_, *tf_, layered_costmap_->globalFrame(), on_observation));
+          name, config, topic_nh_, *tf_, layered_costmap_->globalFrame(), on_observation,
+          data_type == "PointCloud"));
     }
-    ROS_INFO("layer '%s': %s source '%s' on %s (mark <= %.2f m, clear <= %.2f m%s%s)",
-             name_.c_str(), data_type.c_str(), name.c_str(),
-             ros::names::resolve(topic_nh_.getNamespace(), config.topic).c_str(),
-             ic.obstacle_max_range, ic.raytrace_max_range, ranges_from.c_str(),
-             data_type == "PointCloud2"
-                 ? (", heights [" + std::to_string(config.cloud.min_obstacle_height) + ", " +
-                    std::to_string(config.cloud.max_obstacle_height) + "] m")
-                       .c_str()
-                 : "");
+    source_warned_.emplace_back();
+    band_cut_warned_.push_back(false);
+    ROS_INFO(
+        "layer '%s': %s source '%s' on %s (%s%s, mark <= %.2f m, clear <= %.2f m%s, heights "
+        "[%.2f, %.2f] m, +Inf %s, expected_update_rate %.2f s)",
+        name_.c_str(), data_type.c_str(), name.c_str(),
+        ros::names::resolve(topic_nh_.getNamespace(), config.topic).c_str(),
+        ic.marking ? "marking" : "not marking", ic.clearing ? ", clearing" : ", not clearing",
+        ic.obstacle_max_range, ic.raytrace_max_range, ranges_from.c_str(),
+        config.cloud.min_obstacle_height, config.cloud.max_obstacle_height,
+        !is_scan                        ? "n/a"
+        : ic.inf_is_valid               ? "clears (inf_is_no_return)"
+        : config.costmap2d_inf_is_valid ? "is a return at range_max (inf_is_valid)"
+                                        : "ignored",
+        config.expected_update_rate);
   }
   if (sources_.empty()) {
     ROS_WARN("layer '%s': no usable observation_sources; the layer will stay empty", name_.c_str());
+  }
+}
+
+void LogOddsObstacleLayer::applyMarkLimit(double max_obstacle_height) {
+  const double limit = std::min(max_obstacle_height, extra_mark_limit_z_);
+  for (std::size_t k = 0; k < sources_.size(); ++k) {
+    ObservationSource& source = *sources_[k];
+    source.setMarkHeightLimit(limit);
+    const double top = source.config().cloud.max_obstacle_height;
+    if (top > limit && !band_cut_warned_[k]) {
+      band_cut_warned_[k] = true;
+      std::ostringstream msg;
+      msg << "source '" << source.name() << "': points between the layer's marking limit " << limit
+          << " m and the source's max_obstacle_height " << top
+          << " m neither mark nor clear here; costmap_2d lets them clear (not mark)";
+      warnParam(msg.str());
+    }
   }
 }
 
@@ -311,6 +459,7 @@ void LogOddsObstacleLayer::updateBounds(double robot_x, double robot_y, double r
   bool current = true;
   for (const auto& source : sources_) current = current && source->isCurrent();
   current_ = current;
+  warnSourceProblems();
   std::lock_guard<std::mutex> lock(grid_mutex_);
   if (config_.decay_time_s > 0.0) decay();
   if (config_.footprint_clearing_enabled && layered_costmap_->hasRobotPose()) {
@@ -319,6 +468,31 @@ void LogOddsObstacleLayer::updateBounds(double robot_x, double robot_y, double r
   if (config_.clear_tracked_objects) clearTrackedObjects();
   grid_.geometry().expandWorldBox(dirty_, min_x, min_y, max_x, max_y);
   dirty_ = CellBounds{};
+}
+
+void LogOddsObstacleLayer::warnSourceProblems() {
+  const ros::WallTime now = ros::WallTime::now();
+  for (std::size_t k = 0; k < sources_.size(); ++k) {
+    std::string why = sources_[k]->notCurrentReason();
+    if (why.empty()) why = sources_[k]->noPublisherReason(kNoPublisherGraceS);
+    if (why.empty()) continue;
+    // One line per source per period (a ROS_WARN_THROTTLE site is shared by all sources).
+    if (!source_warned_[k].isZero() && (now - source_warned_[k]).toSec() < kSourceWarnPeriodS) {
+      continue;
+    }
+    source_warned_[k] = now;
+    ROS_WARN("layer '%s': %s", name_.c_str(), why.c_str());
+  }
+}
+
+std::string LogOddsObstacleLayer::notCurrentReason() const {
+  std::string reasons;
+  for (const auto& source : sources_) {
+    const std::string why = source->notCurrentReason();
+    if (why.empty()) continue;
+    reasons += (reasons.empty() ? "layer '" + name_ + "': " : "; ") + why;
+  }
+  return reasons;
 }
 
 void LogOddsObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, int max_i,
@@ -424,14 +598,29 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   }
   std::size_t rejected_total = 0;
   std::size_t waiting_total = 0;
-  bool all_current = true;
+  std::string not_current;
+  std::string no_publisher;
   bool any_integrated = sources_.empty();
   for (auto& source : sources_) {
-    const bool current = source->isCurrent();
-    all_current = all_current && current;
+    const std::string not_current_why = source->notCurrentReason();
+    const std::string no_publisher_why = source->noPublisherReason(kNoPublisherGraceS);
+    const bool current = not_current_why.empty();
+    if (not_current.empty()) not_current = not_current_why;
+    if (no_publisher.empty()) no_publisher = no_publisher_why;
+    const std::string p = source->name() + ": ";
+    const std::string topic = source->resolvedTopic();
+    status.add(p + "topic", topic.empty() ? source->config().topic + " (not subscribed)" : topic);
+    status.add(p + "publishers", source->numPublishers());
+    status.add(p + "problem", !not_current_why.empty()    ? not_current_why
+                              : !no_publisher_why.empty() ? no_publisher_why
+                                                          : std::string("none"));
+    const CloudBeamsConfig band = source->heightBand();
+    status.add(p + "height band (m)", "[" + std::to_string(band.min_obstacle_height) + ", " +
+                                          std::to_string(band.max_obstacle_height) + "]");
+    status.add(p + "marking", source->config().integrator.marking);
+    status.add(p + "clearing", source->config().integrator.clearing);
     std::lock_guard<std::mutex> lock(source->mutex());
     const auto& h = source->health();
-    const std::string p = source->name() + ": ";
     any_integrated = any_integrated || h.integrated > 0;
     status.add(p + "data type", source->dataType());
     status.add(p + "messages received", h.received);
@@ -476,9 +665,20 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   status.add("decay time (s)", config.decay_time_s);
   status.add("cells decayed to another state (total)", decayed);
   status.add("memory (bytes)", grid_.memoryBytes());
+  std::vector<std::string> param_warnings;
+  {
+    std::lock_guard<std::mutex> lock(param_warnings_mutex_);
+    param_warnings = param_warnings_;
+  }
+  status.add("parameter warnings", param_warnings.size());
+  for (std::size_t k = 0; k < param_warnings.size(); ++k) {
+    status.add("parameter warning " + std::to_string(k + 1), param_warnings[k]);
+  }
   if (config_errors_.report(status)) return;  // ERROR, with the first problem
-  if (!all_current) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "a source is not current");
+  if (!not_current.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "not current: " + not_current);
+  } else if (!no_publisher.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, no_publisher);
   } else if (waiting_total > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    std::to_string(waiting_total) +
@@ -488,6 +688,10 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   } else if (rejected_total > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    std::to_string(rejected_total) + " message(s) rejected (see counts)");
+  } else if (!param_warnings.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::to_string(param_warnings.size()) +
+                       " parameter warning(s), the first: " + param_warnings.front());
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "integrating");
   }

@@ -1,5 +1,6 @@
 #include "downstream_perception/layers/observation_source.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "downstream_perception/tf_failure.h"
@@ -23,6 +24,16 @@ void ObservationSource::countReceived() {
   std::lock_guard<std::mutex> lock(mutex_);
   ++health_.received;
   health_.last_received = ros::WallTime::now();
+}
+
+void ObservationSource::markSubscribed() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  subscribed_since_ = ros::WallTime::now();
+}
+
+void ObservationSource::markUnsubscribed() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  subscribed_since_ = ros::WallTime();
 }
 
 void ObservationSource::reject(const std::string& reason, const std::string& detail) {
@@ -68,14 +79,50 @@ void ObservationSource::recordIntegration(const IntegrationStats& stats, double 
   health_.last = stats;
   health_.total.accumulate(stats);
   health_.integrate_ms.add(integrate_ms);
+  health_.last_integrated = ros::WallTime::now();
   health_.transform_age_s.add(age_s);
 }
 
 bool ObservationSource::isCurrent() const {
-  if (config_.expected_update_rate <= 0.0) return true;
+  return notCurrentReason().empty();
+}
+
+std::string ObservationSource::notCurrentReason() const {
+  if (config_.expected_update_rate <= 0.0) return "";
+  const std::string topic = resolvedTopic();
   std::lock_guard<std::mutex> lock(mutex_);
-  if (health_.integrated == 0) return false;
-  return (ros::WallTime::now() - health_.last_received).toSec() <= config_.expected_update_rate;
+  if (subscribed_since_.isZero()) return "";  // not subscribed (layer disabled)
+  // costmap_2d counts from the last observation buffered, and from (re)activation before the
+  // first one: a sensor gets expected_update_rate to deliver.
+  const ros::WallTime since = std::max(subscribed_since_, health_.last_integrated);
+  const double silent_s = (ros::WallTime::now() - since).toSec();
+  if (silent_s <= config_.expected_update_rate) return "";
+  std::ostringstream why;
+  why.precision(2);
+  why << std::fixed << "source '" << name_ << "' (" << (topic.empty() ? config_.topic : topic)
+      << "): "
+      << (health_.integrated == 0 ? "no observation integrated yet, " : "no observation for ")
+      << silent_s << " s" << (health_.integrated == 0 ? " after subscribing" : "")
+      << ", expected_update_rate " << config_.expected_update_rate << " s";
+  return why.str();
+}
+
+std::string ObservationSource::noPublisherReason(double grace_s) const {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (subscribed_since_.isZero() ||
+        (ros::WallTime::now() - subscribed_since_).toSec() < grace_s) {
+      return "";
+    }
+  }
+  if (numPublishers() > 0) return "";
+  return "source '" + name_ + "': no publisher on " + resolvedTopic() + " (" + dataType() + ")";
+}
+
+CloudBeamsConfig ObservationSource::heightBand() const {
+  CloudBeamsConfig band = config_.cloud;
+  band.max_obstacle_height = std::min(band.max_obstacle_height, mark_max_z_.load());
+  return band;
 }
 
 }  // namespace downstream_perception

@@ -23,6 +23,7 @@ def test_obstacle_layer_defaults_match_log_odds_config() -> None:
     )
     assert d["combination_method"] == 1  # costmap_2d's default: maximum
     assert d["decay_time_s"] == 0.0 and d["footprint_clearing_enabled"] and d["enabled"]
+    assert d["max_obstacle_height"] == 2.0  # costmap_2d's ObstaclePlugin.cfg default (m)
 
 
 def test_inflation_layer_defaults_match_inflation_config() -> None:

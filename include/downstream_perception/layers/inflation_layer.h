@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "downstream_perception/InflationLayerConfig.h"
+#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/inflation.h"
 #include "downstream_perception/layer.h"
 #include "downstream_perception/running_stats.h"
@@ -35,13 +36,14 @@ class InflationLayer : public Layer {
   using ReconfigureServer = dynamic_reconfigure::Server<InflationLayerConfig>;
   void reconfigure(InflationLayerConfig& config, std::uint32_t level);
   /// Validates `candidate` (with the footprint's inscribed radius) and rebuilds the Inflator;
-  /// an invalid candidate is logged and the previous valid settings stay.
-  void applyConfig(InflationConfig candidate);
+  /// an invalid candidate is logged, kept under `error_key` in diagnostics (until a valid one
+  /// clears it) and the previous valid settings stay. Returns whether it was accepted.
+  bool applyConfig(InflationConfig candidate, const std::string& error_key);
 
   std::mutex mutex_;
   InflationConfig config_;  ///< inscribed_radius comes from the footprint
   std::unique_ptr<Inflator> inflator_;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_;
   bool need_full_window_ = true;  ///< after (re)configuration: update the whole map once
   InflationStats last_;
   std::size_t updates_ = 0;

@@ -1,4 +1,5 @@
-// downstream_perception/LogOddsObstacleLayer: LaserScan and PointCloud2 sources integrated into a
+// downstream_perception/LogOddsObstacleLayer: LaserScan, PointCloud and PointCloud2 sources
+// (costmap_2d's source keys, meanings and defaults) integrated into a
 // log-odds grid (hit/miss increments, clamp, exact ray clearing, REP-117 semantics), each
 // message placed with the transform at its own stamp. The master gets LETHAL
 // (l > occupied_log_odds), FREE (l < free_log_odds) or, for cells in between, nothing (they keep
@@ -12,6 +13,7 @@
 #include <dynamic_reconfigure/server.h>
 #include <boost/thread/recursive_mutex.hpp>
 
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -23,6 +25,7 @@
 #include "downstream_perception/layer.h"
 #include "downstream_perception/layers/observation_source.h"
 #include "downstream_perception/layers/track_inbox.h"
+#include "downstream_perception/param_reader.h"
 
 namespace downstream_perception {
 
@@ -33,6 +36,7 @@ struct ObstacleLayerConfig {
   double decay_time_s = 0.0;  ///< s, time constant of the fade toward unknown; 0 = off
   bool clear_tracked_objects = false;
   double tracked_clearing_margin_m = 0.1;  ///< m: growth of each track's box before clearing
+  double max_obstacle_height = 2.0;        ///< m, costmap_2d's layer key: no marks above it
 };
 
 class LogOddsObstacleLayer : public Layer {
@@ -50,14 +54,28 @@ class LogOddsObstacleLayer : public Layer {
   void activate() override;
   void deactivate() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  /// Names the silent source(s) and their topics when the layer is not current.
+  std::string notCurrentReason() const override;
 
  protected:
   void onInitialize() override;
+  /// Subclasses read their own keys of the layer namespace here (before unknown keys are named).
+  virtual void readLayerParams(ParamReader& reader) { (void)reader; }
+  /// m, global frame: a subclass's own upper marking limit (FlatVoxelLayer: its voxel column's
+  /// top); combined with max_obstacle_height. Set in readLayerParams().
+  double extra_mark_limit_z_ = std::numeric_limits<double>::infinity();
+  /// A WARN about a key of this layer (kept for diagnostics).
+  void warnParam(const std::string& msg);
 
  private:
   using ReconfigureServer = dynamic_reconfigure::Server<LogOddsObstacleLayerConfig>;
   void reconfigure(LogOddsObstacleLayerConfig& config, std::uint32_t level);
-  void readSources();
+  void readSources(const std::string& names);
+  /// The marking limit min(max_obstacle_height, extra_mark_limit_z_) into every source; WARNs
+  /// once per source whose own band reaches above it.
+  void applyMarkLimit(double max_obstacle_height);
+  /// WARNs (throttled, per source) for silent sources and topics without a publisher.
+  void warnSourceProblems();
   /// costmap_2d's obstacle_range / raytrace_range into *ic (unless ours are set at the source);
   /// returns "; obstacle_range from <key>..." for the start-up line, or "".
   std::string readCostmap2dRanges(const ros::NodeHandle& source_nh, const std::string& source,
@@ -84,6 +102,10 @@ class LogOddsObstacleLayer : public Layer {
   std::size_t tracks_cleared_last_ = 0;
   bool track_unknown_space_ = true;
   std::vector<std::unique_ptr<ObservationSource>> sources_;
+  std::vector<ros::WallTime> source_warned_;  ///< per source: last throttled WARN
+  std::vector<bool> band_cut_warned_;         ///< per source: the mark-limit WARN was given
+  mutable std::mutex param_warnings_mutex_;
+  std::vector<std::string> param_warnings_;  ///< wrong types, unsupported and unknown keys
   ConfigErrorLog config_errors_;
   std::unique_ptr<ReconfigureServer> reconfigure_server_;
   boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes

@@ -1,8 +1,8 @@
-// One observation source of the obstacle layer (a LaserScan or PointCloud2 topic): subscription
-// through a tf2 MessageFilter (a message is released only once the transform at its own stamp
-// exists), message checks, and per-source health counters. A source turns each accepted message
-// into beams in the layer's global frame; the layer integrates them. Parameters live in
-// <layer ns>/<source name>.
+// One observation source of the obstacle layer (a LaserScan, PointCloud or PointCloud2 topic):
+// subscription through a tf2 MessageFilter (a message is released only once the transform at its
+// own stamp exists), message checks, and per-source health counters. A source turns each accepted
+// message into beams in the layer's global frame; the layer integrates them. Parameters live in
+// <layer ns>/<source name> (costmap_2d's keys with costmap_2d's defaults, see readSources()).
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
@@ -10,7 +10,10 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 
+#include <atomic>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -27,11 +30,14 @@ namespace downstream_perception {
 struct ObservationSourceConfig {
   std::string topic;                     ///< defaults to the source name
   std::string sensor_frame;              ///< overrides the message's frame_id when non-empty
-  double expected_update_rate = 0;       ///< s between messages before "not current"; 0 = off
+  double expected_update_rate = 0;       ///< s between observations before "not current"; 0 = off
+  double observation_persistence = 0;    ///< s, costmap_2d's key: accepted, see readSources()
   int tf_queue_size = 20;                ///< messages held while waiting for tf
-  ScanIntegratorConfig integrator;       ///< marking, clearing, ranges, inf_is_valid, ...
-  CloudBeamsConfig cloud;                ///< PointCloud2 only: the obstacle height band
+  ScanIntegratorConfig integrator;       ///< marking, clearing, ranges, +Inf as no return, ...
+  CloudBeamsConfig cloud;                ///< the obstacle height band (every source type)
   bool per_beam_time_correction = true;  ///< LaserScan only: de-skew with time_increment
+  /// LaserScan only, costmap_2d's inf_is_valid: +Inf becomes a return at range_max - 0.1 mm.
+  bool costmap2d_inf_is_valid = false;
 };
 
 /// The beams of one accepted message, in the layer's global frame.
@@ -48,10 +54,14 @@ class ObservationSource {
   virtual ~ObservationSource() = default;
   virtual void subscribe() = 0;
   virtual void unsubscribe() = 0;
-  /// "LaserScan" or "PointCloud2".
+  /// "LaserScan", "PointCloud" or "PointCloud2".
   virtual const char* dataType() const = 0;
   /// Messages held back for their transform for a while, per frame, with the reason.
   virtual std::vector<TfWait> waitingForTf() const = 0;
+  /// The resolved topic while subscribed, else "".
+  virtual std::string resolvedTopic() const = 0;
+  /// Publishers connected to the topic while subscribed.
+  virtual std::uint32_t numPublishers() const = 0;
 
   const std::string& name() const { return name_; }
   const ObservationSourceConfig& config() const { return config_; }
@@ -68,18 +78,33 @@ class ObservationSource {
     IntegrationStats last;   ///< the last message's integration
     IntegrationStats total;  ///< since start
     ros::WallTime last_received;
+    ros::WallTime last_integrated;
   };
   const Health& health() const { return health_; }
   std::mutex& mutex() { return mutex_; }
   void recordIntegration(const IntegrationStats& stats, double integrate_ms, double age_s);
-  /// True if messages arrive as often as expected_update_rate demands.
+  /// True if observations arrive as often as expected_update_rate demands (costmap_2d's rule:
+  /// the time since the last observation, or since subscribing, is at most expected_update_rate).
   bool isCurrent() const;
+  /// "" while current, else why not, naming the source and its topic.
+  std::string notCurrentReason() const;
+  /// "" while a publisher is connected (or subscribed for less than `grace_s`), else the WARN text
+  /// naming the topic.
+  std::string noPublisherReason(double grace_s) const;
+  /// The layer's marking limit in the global frame (m): max_obstacle_height of the layer, for a
+  /// voxel layer also the top of its voxel column. Points above it neither mark nor clear.
+  void setMarkHeightLimit(double max_z) { mark_max_z_ = max_z; }
+  /// [min_obstacle_height, min(max_obstacle_height, the layer's marking limit)] (m).
+  CloudBeamsConfig heightBand() const;
 
  protected:
   ObservationSource(std::string name, const ObservationSourceConfig& config, ros::NodeHandle nh,
                     tf2_ros::Buffer& tf, std::string global_frame, Callback on_observation);
 
   void countReceived();
+  /// Subscribed now: expected_update_rate and the publisher check count from here.
+  void markSubscribed();
+  void markUnsubscribed();
   void reject(const std::string& reason, const std::string& detail);
   void note(const std::string& what);
   void onTfFailure(const std::string& frame, const ros::Time& stamp,
@@ -103,6 +128,8 @@ class ObservationSource {
  private:
   mutable std::mutex mutex_;
   Health health_;
+  ros::WallTime subscribed_since_;  ///< zero while unsubscribed; guarded by mutex_
+  std::atomic<double> mark_max_z_{std::numeric_limits<double>::infinity()};
 };
 
 }  // namespace downstream_perception
