@@ -59,12 +59,20 @@ std::string InflationConfig::validate(double resolution_m) const {
   return out.str();
 }
 
+namespace {
+// A relative tolerance so a cell exactly on the radius counts as inside: 0.55 m is
+// 11.000000000000002 cells of 0.05 m in double, and a map's resolution arrives as float32
+// (nav_msgs/MapMetaData: 0.1 is 0.100000001490116, so 1.0 m is 9.99999985 cells). 1e-6 is well
+// above float32's relative error (6e-8) and far below any real cell fraction.
+constexpr double kRadiusTolerance = 1e-6;
+}  // namespace
+
 std::uint8_t inflationCost(double distance_m, const InflationConfig& config) {
   if (distance_m == 0.0) return cost::kLethalObstacle;
-  // A relative tolerance so a cell exactly on the radius (0.55 m = 11 cells of 0.05 m, which is
-  // 11.000000000000002 cells in double) counts as inside.
-  if (distance_m > config.inflation_radius * (1.0 + 1e-9) + 1e-12) return cost::kFreeSpace;
-  if (distance_m <= config.inscribed_radius * (1.0 + 1e-9) + 1e-12) {
+  if (distance_m > config.inflation_radius * (1.0 + kRadiusTolerance) + 1e-12) {
+    return cost::kFreeSpace;
+  }
+  if (distance_m <= config.inscribed_radius * (1.0 + kRadiusTolerance) + 1e-12) {
     return cost::kInscribedInflatedObstacle;
   }
   const double factor =
@@ -151,8 +159,9 @@ void Inflator::setConfig(const InflationConfig& config, double resolution_m) {
   config_ = config;
   resolution_ = resolution_m;
   const double radius = config.inflation_radius / resolution_m;  // cells
-  radius_cells_ = static_cast<int>(std::floor(radius * (1.0 + 1e-9) + 1e-9));
-  const auto max_d2 = static_cast<std::int64_t>(std::floor(radius * radius * (1.0 + 1e-9) + 1e-9));
+  radius_cells_ = static_cast<int>(std::floor(radius * (1.0 + kRadiusTolerance) + 1e-9));
+  const auto max_d2 =
+      static_cast<std::int64_t>(std::floor(radius * radius * (1.0 + kRadiusTolerance) + 1e-9));
   cost_by_d2_.assign(static_cast<std::size_t>(max_d2) + 1, 0);
   for (std::int64_t d2 = 0; d2 <= max_d2; ++d2) {
     cost_by_d2_[d2] = inflationCost(std::sqrt(static_cast<double>(d2)) * resolution_m, config);

@@ -3,14 +3,20 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/layered_costmap.h"
+#include "downstream_perception/param_reader.h"
 
 namespace downstream_perception {
 
 void InflationLayer::onInitialize() {
+  ParamReader params(nh_, "layer '" + name_ + "'");
+  params.reconfigureKeys<InflationLayerConfig>();
+  params.warnUnknown();
+  param_warnings_ = params.warnings();
   // The server reads the YAML values (or the .cfg defaults, equal to InflationConfig's) and calls
   // reconfigure() at once: one code path for start-up and live changes.
   reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
@@ -81,12 +87,31 @@ bool InflationLayer::applyConfig(InflationConfig candidate, const std::string& e
   config_ = candidate;
   inflator_ = std::make_unique<Inflator>(config_, resolution);
   need_full_window_ = true;
+  noteRadiusDifference(resolution);
   ROS_INFO(
       "layer '%s': inflation radius %.3f m (%d cells), cost_scaling_factor %.2f 1/m, "
       "inscribed radius %.3f m",
       name_.c_str(), config_.inflation_radius, inflator_->radiusCells(),
       config_.cost_scaling_factor, config_.inscribed_radius);
   return accepted;
+}
+
+void InflationLayer::noteRadiusDifference(double resolution) {
+  // costmap_2d inflates every cell within ceil(inflation_radius / resolution) cells; we inflate
+  // within the radius itself. They differ only when the radius is not a whole number of cells.
+  const double cells = config_.inflation_radius / resolution;
+  const double theirs = std::ceil(cells * (1.0 - 1e-6));
+  std::string note;
+  if (theirs > inflator_->radiusCells()) {
+    note = "inflation_radius " + toText(config_.inflation_radius) + " m is " + toText(cells) +
+           " cells of " + toText(resolution) +
+           " m: costmap_2d inflates to ceil = " + toText(theirs) + " cells (" +
+           toText(theirs * resolution) + " m), this layer to the radius itself (" +
+           toText(inflator_->radiusCells()) + " whole cells)";
+  }
+  if (!note.empty() && note != radius_note_)
+    ROS_WARN("layer '%s': %s", name_.c_str(), note.c_str());
+  radius_note_ = note;
 }
 
 void InflationLayer::updateBounds(double, double, double, double* min_x, double* min_y,
@@ -148,6 +173,11 @@ void InflationLayer::onFootprintChanged() {
 void InflationLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
   status.summary(diagnostic_msgs::DiagnosticStatus::OK, "inflating");
+  if (!param_warnings_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, param_warnings_.front());
+  }
+  addParamWarnings(status, param_warnings_);
+  if (!radius_note_.empty()) status.add("difference from costmap_2d", radius_note_);
   status.add("inflation radius (m)", config_.inflation_radius);
   status.add("inflation radius (cells)", inflator_ ? inflator_->radiusCells() : 0);
   status.add("cost scaling factor (1/m)", config_.cost_scaling_factor);

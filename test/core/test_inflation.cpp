@@ -364,3 +364,23 @@ TEST(Inflator, ExtremeShiftsEqualFullRecomputation) {
     ASSERT_EQ(master.cells(), fresh.cells()) << "shift " << d;
   }
 }
+
+TEST(InflationRadius, ACellExactlyOnTheRadiusCountsAtAFloat32Resolution) {
+  // A map_server map's resolution is float32: 0.1 arrives as 0.100000001490116, so 1.0 m is
+  // 9.99999985 cells. The cell 10 cells from the wall is on the radius and gets a cost, as in
+  // costmap_2d (252 * exp(-3 * (1.0 - 0.087)) = 16).
+  const double resolution = static_cast<double>(0.1f);
+  InflationConfig config;
+  config.inflation_radius = 1.0;
+  config.cost_scaling_factor = 3.0;
+  config.inscribed_radius = 0.087;
+  const GridGeometry g(41, 41, resolution, 0.0, 0.0);
+  Costmap map(g, cost::kFreeSpace);
+  map.setCost(20, 20, cost::kLethalObstacle);
+  Inflator inflator(config, resolution);
+  EXPECT_EQ(inflator.radiusCells(), 10);
+  inflator.update(&map, everything(g));
+  EXPECT_EQ(map.cost(30, 20), 16);
+  EXPECT_EQ(map.cost(20, 10), 16);
+  EXPECT_EQ(map.cost(31, 20), 0);
+}

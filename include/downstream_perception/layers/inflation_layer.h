@@ -39,12 +39,17 @@ class InflationLayer : public Layer {
   /// an invalid candidate is logged, kept under `error_key` in diagnostics (until a valid one
   /// clears it) and the previous valid settings stay. Returns whether it was accepted.
   bool applyConfig(InflationConfig candidate, const std::string& error_key);
+  /// WARNs (once per value) when costmap_2d's ceil(radius / resolution) cells reach further.
+  void noteRadiusDifference(double resolution);
 
   std::mutex mutex_;
   InflationConfig config_;  ///< inscribed_radius comes from the footprint
   std::unique_ptr<Inflator> inflator_;
   ConfigErrorLog config_errors_;
-  bool need_full_window_ = true;  ///< after (re)configuration: update the whole map once
+  bool need_full_window_ = true;
+  std::string radius_note_;                  ///< how this radius differs from costmap_2d's, or ""
+  std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)  ///< after
+                                             ///< (re)configuration: update the whole map once
   InflationStats last_;
   std::size_t updates_ = 0;
   RunningStats update_ms_;
