@@ -57,16 +57,9 @@ void beamsFromCloud(const ScanIntegrator& integrator, const CloudBeamsConfig& co
         continue;
       }
     }
-    const double dx = q.x() - t.x();
-    const double dy = q.y() - t.y();
-    const double range = std::hypot(dx, dy);
-    if (!(range > 0.0)) {
-      ++stats->beams;
-      ++stats->beams_invalid;  // straight above or below the sensor: no horizontal direction
-      continue;
-    }
-    integrator.beamFromDirection(t.x(), t.y(), dx / range, dy / range, range, 0.0, kInf, beams,
-                                 stats);
+    // The point itself is the hit (a point straight above or below the sensor marks the
+    // sensor's cell, as in costmap_2d).
+    integrator.beamToPoint(t.x(), t.y(), q.x(), q.y(), 0.0, kInf, beams, stats);
   }
 }
 

@@ -31,15 +31,29 @@ GridGeometry::GridGeometry(int size_x, int size_y, double resolution_m, double o
       size_y_(size_y),
       resolution_(resolution_m),
       origin_x_(origin_x_m),
-      origin_y_(origin_y_m) {
+      origin_y_(origin_y_m),
+      lattice_x_(origin_x_m),
+      lattice_y_(origin_y_m) {
   const std::string why = validate(size_x, size_y, resolution_m, origin_x_m, origin_y_m);
   if (!why.empty()) throw std::invalid_argument(why);
 }
 
+GridGeometry GridGeometry::shiftedBy(int dx, int dy) const {
+  // The origin moves as costmap_2d moves it (origin + cells * resolution), so a host's origin and
+  // ours stay equal; cells are still counted on the unchanged lattice.
+  GridGeometry g(size_x_, size_y_, resolution_, origin_x_ + dx * resolution_,
+                 origin_y_ + dy * resolution_);
+  g.lattice_x_ = lattice_x_;
+  g.lattice_y_ = lattice_y_;
+  g.lattice_shift_x_ = lattice_shift_x_ + dx;
+  g.lattice_shift_y_ = lattice_shift_y_ + dy;
+  return g;
+}
+
 bool GridGeometry::worldToCell(double wx, double wy, CellIndex* cell) const {
   if (!std::isfinite(wx) || !std::isfinite(wy)) return false;
-  const double gx = std::floor((wx - origin_x_) / resolution_);
-  const double gy = std::floor((wy - origin_y_) / resolution_);
+  const double gx = cellCoordinate(latticeUnitsX(wx), lattice_shift_x_);
+  const double gy = cellCoordinate(latticeUnitsY(wy), lattice_shift_y_);
   // Compare as doubles first: casting a huge value to int is undefined.
   if (gx < 0.0 || gy < 0.0 || gx >= size_x_ || gy >= size_y_) {
     cell->x = static_cast<int>(std::clamp(gx, -1.0, static_cast<double>(size_x_)));
@@ -64,10 +78,10 @@ CellBounds GridGeometry::worldBoxToCells(double min_x, double min_y, double max_
                                          double max_y) const {
   CellBounds b;
   if (!(min_x <= max_x) || !(min_y <= max_y)) return b;
-  const double lo_x = std::floor((min_x - origin_x_) / resolution_);
-  const double lo_y = std::floor((min_y - origin_y_) / resolution_);
-  const double hi_x = std::floor((max_x - origin_x_) / resolution_);
-  const double hi_y = std::floor((max_y - origin_y_) / resolution_);
+  const double lo_x = cellCoordinate(latticeUnitsX(min_x), lattice_shift_x_);
+  const double lo_y = cellCoordinate(latticeUnitsY(min_y), lattice_shift_y_);
+  const double hi_x = cellCoordinate(latticeUnitsX(max_x), lattice_shift_x_);
+  const double hi_y = cellCoordinate(latticeUnitsY(max_y), lattice_shift_y_);
   if (hi_x < 0.0 || hi_y < 0.0 || lo_x >= size_x_ || lo_y >= size_y_) return b;
   b.min_x = static_cast<int>(std::max(lo_x, 0.0));
   b.min_y = static_cast<int>(std::max(lo_y, 0.0));

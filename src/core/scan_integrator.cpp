@@ -31,6 +31,32 @@ inline int stateClass(int v, int free_units, int occupied_units) {
   return (v > occupied_units) - (v < free_units);
 }
 
+// The walk of RayWalk::walk on the cell pointer: visits every cell before the end cell, crossing
+// a corner diagonally (see RayWalk), and returns the end cell's pointer; *visited counts the
+// cells visited. Kept out of line: only rays between lattice-exact points come here.
+template <class Visit>
+__attribute__((noinline)) std::int16_t* walkThroughCorners(const RayWalk& walk, std::int16_t* p,
+                                                           std::ptrdiff_t dpx, std::ptrdiff_t dpy,
+                                                           std::size_t* visited, Visit&& visit) {
+  std::int64_t err = walk.err;
+  for (int left = walk.stepsLeft(); left > 0; --left) {
+    visit(p);
+    ++*visited;
+    if (err == walk.tie && left >= 2) {  // both edges of the corner in one step
+      p += dpx + dpy;
+      err += walk.err_step_x - walk.err_step_y;
+      --left;
+    } else if (err <= 0) {
+      p += dpx;
+      err += walk.err_step_x;
+    } else {
+      p += dpy;
+      err -= walk.err_step_y;
+    }
+  }
+  return p;
+}
+
 }  // namespace
 
 IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
@@ -116,17 +142,27 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     const std::ptrdiff_t dpy = walk.sy * size_x;
     const std::int64_t esx = walk.err_step_x;
     const std::int64_t esy = walk.err_step_y;
-    std::int64_t err = walk.err;
-    int left = walk.stepsLeft();
-    walked += static_cast<std::size_t>(left);
-    for (; left > 0; --left) {
-      if (__builtin_expect(!skipsMiss(*p), 0)) clearCell(p);
-      if (err <= 0) {
-        p += dpx;
-        err += esx;
-      } else {
-        p += dpy;
-        err -= esy;
+    if (__builtin_expect(walk.corners, 0)) {
+      // A ray that may pass exactly through cell corners (lattice-exact points): its own loop,
+      // out of line, so the common loop below stays the plain two-way step.
+      std::size_t visited = 0;
+      p = walkThroughCorners(walk, p, dpx, dpy, &visited, [&](std::int16_t* q) {
+        if (!skipsMiss(*q)) clearCell(q);
+      });
+      walked += visited;
+    } else {
+      std::int64_t err = walk.err;
+      int left = walk.stepsLeft();
+      walked += static_cast<std::size_t>(left);
+      for (; left > 0; --left) {
+        if (__builtin_expect(!skipsMiss(*p), 0)) clearCell(p);
+        if (err <= 0) {
+          p += dpx;
+          err += esx;
+        } else {
+          p += dpy;
+          err -= esy;
+        }
       }
     }
     if (beam.clear_end_cell || end_clipped) {
@@ -188,6 +224,29 @@ void ScanIntegrator::beamFromDirection(double origin_x, double origin_y, double 
                                        double range, double range_min, double range_max,
                                        std::vector<BeamUpdate>* beams,
                                        IntegrationStats* stats) const {
+  makeBeam(origin_x, origin_y, c, s, range, range_min, range_max, nullptr, beams, stats);
+}
+
+void ScanIntegrator::beamToPoint(double origin_x, double origin_y, double point_x, double point_y,
+                                 double range_min, double range_max, std::vector<BeamUpdate>* beams,
+                                 IntegrationStats* stats) const {
+  const double dx = point_x - origin_x;
+  const double dy = point_y - origin_y;
+  const double range = std::hypot(dx, dy);
+  const double point[2] = {point_x, point_y};
+  if (!(range > 0.0)) {
+    // No horizontal direction (or not finite: makeBeam refuses NaN). Any direction will do: a
+    // return at range 0 marks where it is and clears nothing.
+    makeBeam(origin_x, origin_y, 1.0, 0.0, range, range_min, range_max, point, beams, stats);
+    return;
+  }
+  makeBeam(origin_x, origin_y, dx / range, dy / range, range, range_min, range_max, point, beams,
+           stats);
+}
+
+void ScanIntegrator::makeBeam(double origin_x, double origin_y, double c, double s, double range,
+                              double range_min, double range_max, const double* point,
+                              std::vector<BeamUpdate>* beams, IntegrationStats* stats) const {
   ++stats->beams;
   bool no_return = false;
   if (std::isnan(range) || range == -std::numeric_limits<double>::infinity()) {
@@ -214,8 +273,8 @@ void ScanIntegrator::beamFromDirection(double origin_x, double origin_y, double 
         range >= config_.obstacle_min_range && range <= config_.obstacle_max_range;
     if (config_.marking && in_obstacle_range) {
       beam.mark = true;
-      beam.hit_x = origin_x + range * c;
-      beam.hit_y = origin_y + range * s;
+      beam.hit_x = point != nullptr ? point[0] : origin_x + range * c;
+      beam.hit_y = point != nullptr ? point[1] : origin_y + range * s;
     } else if (!in_obstacle_range) {
       ++stats->beams_beyond_obstacle_range;
     }
@@ -232,8 +291,10 @@ void ScanIntegrator::beamFromDirection(double origin_x, double origin_y, double 
       beam.clear = true;
       beam.start_x = origin_x + start * c;
       beam.start_y = origin_y + start * s;
-      beam.end_x = origin_x + end * c;
-      beam.end_y = origin_y + end * s;
+      // A clearing ray that ends at a measured point ends exactly there: its end cell is then the
+      // cell the hit marks (origin + range * direction can round across a cell edge).
+      beam.end_x = end_is_hit && point != nullptr ? point[0] : origin_x + end * c;
+      beam.end_y = end_is_hit && point != nullptr ? point[1] : origin_y + end * s;
       beam.clear_end_cell = !end_is_hit;
     }
   }

@@ -31,16 +31,16 @@ TEST(CloudBeams, HeightBandOriginAndInvalidPoints) {
       {2.0f, 0.0f, -0.45f, 1.0f},  // z = 0.05: floor, skipped
       {2.0f, 0.0f, 1.2f, 1.0f},    // z = 1.7: above the band, skipped
       {nan, 0.0f, 0.0f, 1.0f},     // depth hole: invalid
-      {0.0f, 0.0f, 0.5f, 1.0f},    // straight above the sensor: invalid
       {0.0f, 4.5f, 0.0f, 1.0f},    // beyond obstacle_max_range: clears only
+      {0.0f, 0.0f, 0.5f, 1.0f},    // z = 1.0, straight above the sensor: marks its cell
   };
   std::vector<BeamUpdate> beams;
   IntegrationStats stats;
   beamsFromCloud(integrator, cc, reinterpret_cast<const unsigned char*>(&cloud[0].x), cloud.size(),
                  sizeof(PointXYZI), pose, &beams, &stats);
-  ASSERT_EQ(beams.size(), 2u);
+  ASSERT_EQ(beams.size(), 3u);
   EXPECT_EQ(stats.points_outside_height, 2u);
-  EXPECT_EQ(stats.beams_invalid, 2u);
+  EXPECT_EQ(stats.beams_invalid, 1u);
   EXPECT_EQ(stats.beams_beyond_obstacle_range, 1u);
   EXPECT_TRUE(beams[0].mark);
   EXPECT_NEAR(beams[0].hit_x, 3.0, 1e-9);
@@ -50,6 +50,11 @@ TEST(CloudBeams, HeightBandOriginAndInvalidPoints) {
   EXPECT_FALSE(beams[1].mark);
   EXPECT_TRUE(beams[1].clear);
   EXPECT_NEAR(beams[1].end_y, 6.5, 1e-9);  // 4.5 m up the +y axis
+  // Zero horizontal range: a hit at the sensor's own position, and nothing to clear.
+  EXPECT_TRUE(beams[2].mark);
+  EXPECT_FALSE(beams[2].clear);
+  EXPECT_EQ(beams[2].hit_x, 1.0);
+  EXPECT_EQ(beams[2].hit_y, 2.0);
 }
 
 TEST(CloudBeams, RotatedSensorAndIntegration) {

@@ -76,10 +76,12 @@ TEST(Bresenham, EndpointsIncludedAndConnected) {
 
 TEST(TraverseRay, GoldenLineThroughCellCentresVisitsEveryCrossedCell) {
   // The same beam as the Bresenham example, from the centre of (2,2) to the centre of (7,5), in a
-  // 1 m grid. It really crosses 9 cells (a 4-connected walk); Bresenham lists 6 and skips 3.
+  // 1 m grid. It really crosses 8 cells; Bresenham lists 6 and skips 2. At x = 5 it passes
+  // exactly through the corner (5, 4): (5, 3) and (4, 4) are touched at that point only, so
+  // neither is crossed (an x-first tie-break used to list (5, 3)).
   const GridGeometry g(20, 20, 1.0, 0.0, 0.0);
   const auto cells = pairs(rayCells(g, 2.5, 2.5, 7.5, 5.5));
-  const std::vector<std::pair<int, int>> expected = {{2, 2}, {3, 2}, {3, 3}, {4, 3}, {5, 3},
+  const std::vector<std::pair<int, int>> expected = {{2, 2}, {3, 2}, {3, 3}, {4, 3},
                                                      {5, 4}, {6, 4}, {6, 5}, {7, 5}};
   EXPECT_EQ(cells, expected);
   // Every Bresenham cell except the corner-adjacent ones is on the exact path.
@@ -174,9 +176,19 @@ TEST(TraverseRay, EndpointsOnEdgesAndCornersEndInTheEndCell) {
           << x0 << "," << y0 << " -> " << x1 << "," << y1;
       for (std::size_t i = 0; i < cells.size(); ++i) {
         ASSERT_TRUE(g.inBounds(cells[i].x, cells[i].y));
-        if (i > 0) {
-          ASSERT_EQ(std::abs(cells[i].x - cells[i - 1].x) + std::abs(cells[i].y - cells[i - 1].y),
-                    1);
+        if (i == 0) continue;
+        const int step_x = cells[i].x - cells[i - 1].x;
+        const int step_y = cells[i].y - cells[i - 1].y;
+        ASSERT_TRUE(std::abs(step_x) <= 1 && std::abs(step_y) <= 1 && (step_x | step_y) != 0);
+        if (step_x != 0 && step_y != 0) {
+          // A diagonal step only where the segment passes exactly through the corner the two
+          // cells share (exact in integers: in half cells from the grid's origin the ends are
+          // (a, b) and (c, d), the corner is at twice its cell coordinates).
+          const long corner_x = 2L * std::max(cells[i].x, cells[i - 1].x);
+          const long corner_y = 2L * std::max(cells[i].y, cells[i - 1].y);
+          const long ax = a, ay = b, bx = c, by = d;
+          ASSERT_EQ((corner_x - ax) * (by - ay) - (corner_y - ay) * (bx - ax), 0)
+              << "diagonal step off a corner: " << x0 << "," << y0 << " -> " << x1 << "," << y1;
         }
       }
     }
@@ -184,8 +196,9 @@ TEST(TraverseRay, EndpointsOnEdgesAndCornersEndInTheEndCell) {
 }
 
 namespace {
-// Every cell in the grid, 4-connected, none twice: what the scan integrator's pointer walk
-// relies on (a cell outside the grid is a read and write past the cell array).
+// Every cell in the grid, 8-connected (a diagonal step is a corner passed exactly), none twice:
+// what the scan integrator's pointer walk relies on (a cell outside the grid is a read and write
+// past the cell array).
 void expectWalkInGrid(const GridGeometry& g, const std::vector<CellIndex>& cells,
                       const std::string& what) {
   std::set<std::pair<int, int>> unique;
@@ -194,8 +207,9 @@ void expectWalkInGrid(const GridGeometry& g, const std::vector<CellIndex>& cells
         << what << ": cell " << i << " (" << cells[i].x << ", " << cells[i].y << ") is outside";
     ASSERT_TRUE(unique.insert({cells[i].x, cells[i].y}).second) << what << ": cell visited twice";
     if (i > 0) {
-      ASSERT_EQ(std::abs(cells[i].x - cells[i - 1].x) + std::abs(cells[i].y - cells[i - 1].y), 1)
-          << what;
+      const int step_x = std::abs(cells[i].x - cells[i - 1].x);
+      const int step_y = std::abs(cells[i].y - cells[i - 1].y);
+      ASSERT_TRUE(step_x <= 1 && step_y <= 1 && step_x + step_y > 0) << what;
     }
   }
 }
@@ -271,7 +285,15 @@ TEST(ClipSegment, HugeAndExtremeGridsStayInside) {
   const int longest = GridGeometry::kMaxCellsPerAxis;
   const GridGeometry long_grid(longest, 64, 1.0, 0.0, 0.0);
   const auto along = rayCells(long_grid, -10.0, 0.5, longest + 10.0, 63.5);
-  EXPECT_EQ(along.size(), static_cast<std::size_t>(longest) + 63);
+  // Every crossing is walked: one cell per crossing, except a corner (both edges in one diagonal
+  // step). This line passes exactly through lattice corners, e.g. (233008, 4): 7 (x + 10) =
+  // (2k - 1) * 233018 has integer solutions.
+  std::size_t diagonals = 0;
+  for (std::size_t i = 1; i < along.size(); ++i) {
+    diagonals += along[i].x != along[i - 1].x && along[i].y != along[i - 1].y;
+  }
+  EXPECT_GE(diagonals, 1u);
+  EXPECT_EQ(along.size() + diagonals, static_cast<std::size_t>(longest) + 63);
   EXPECT_EQ(along.back(), (CellIndex{longest - 1, 63}));
   for (const CellIndex& c : along) ASSERT_TRUE(long_grid.inBounds(c.x, c.y));
   // Resolutions at both ends of the doubles.

@@ -5,8 +5,10 @@
 // whose height z (in the grid's frame) lies outside [min_obstacle_height, max_obstacle_height]
 // are skipped entirely: they neither mark nor clear (the floor and the ceiling are not
 // obstacles, and a ray to them says nothing about the obstacle band). A point inside the band
-// is a return at its horizontal distance from the sensor origin: it marks within
-// obstacle_max_range and clears from the sensor to it, like a laser beam. Non-finite points
+// is a return at its horizontal distance from the sensor origin: it marks the cell containing it
+// within obstacle_max_range and clears from the sensor to it, like a laser beam; a point straight
+// above or below the sensor (zero horizontal range) marks the sensor's own cell and clears
+// nothing, as costmap_2d marks it. Non-finite points
 // (NaN from depth holes) are invalid and ignored. With merge_cell_m > 0 only the first point
 // per merge cell casts a beam: the same cells are marked, and the clearing rays differ from the
 // per-point ones only within that cell's width at the far end.

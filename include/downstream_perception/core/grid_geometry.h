@@ -1,10 +1,19 @@
 // Placement of a 2-D grid in a world frame: origin (lower-left corner of cell (0, 0)),
 // square cells of `resolution` metres, size_x by size_y cells, row-major (index = y * size_x + x),
 // the same layout as nav_msgs/OccupancyGrid.
+//
+// Which cell a world point lies in is counted on a fixed lattice: from the origin the grid was
+// built with (its "lattice anchor") in whole cells, minus the whole cells the origin has moved
+// since (rolling-window shifts). The origin itself moves by adding dx * resolution, which rounds:
+// counted from the moved origin, a point lying exactly on a cell edge (a simulated wall face, a
+// point cloud on a lattice) would fall on one side of the edge after one shift and on the other
+// after the next, and be marked in both cells. Counted on the lattice, the same world point is in
+// the same world cell whatever the window did.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -74,10 +83,11 @@ class GridGeometry {
   }
 
   /// Cell containing a world point, by floor (an endpoint exactly on a cell edge belongs to the
-  /// cell above it; negative offsets floor toward -inf). No bounds check.
+  /// cell above it; negative offsets floor toward -inf), counted on the lattice (see the file
+  /// comment). No bounds check.
   CellIndex worldToCellUnbounded(double wx, double wy) const {
-    return {static_cast<int>(std::floor((wx - origin_x_) / resolution_)),
-            static_cast<int>(std::floor((wy - origin_y_) / resolution_))};
+    return {static_cast<int>(cellCoordinate(latticeUnitsX(wx), lattice_shift_x_)),
+            static_cast<int>(cellCoordinate(latticeUnitsY(wy), lattice_shift_y_))};
   }
   /// Same as worldToCellUnbounded; returns false (and leaves *cell set) when outside the grid
   /// or when the point is not finite.
@@ -94,6 +104,21 @@ class GridGeometry {
   void expandWorldBox(const CellBounds& cells, double* min_x, double* min_y, double* max_x,
                       double* max_y) const;
 
+  /// The grid after a rolling-window shift: same size, origin moved by (dx, dy) whole cells (in
+  /// double: no integer overflow), the same lattice. Throws std::invalid_argument if the new
+  /// origin is not finite.
+  GridGeometry shiftedBy(int dx, int dy) const;
+
+  /// A world coordinate in cells from the lattice anchor: the one expression every cell lookup
+  /// floors (the ray walker's too, so that its end cell is the cell a hit marks).
+  double latticeUnitsX(double wx) const { return (wx - lattice_x_) / resolution_; }
+  double latticeUnitsY(double wy) const { return (wy - lattice_y_) / resolution_; }
+  /// Whole cells the origin moved since the anchor: cell index = floor(lattice units) - shift.
+  std::int64_t latticeShiftX() const { return lattice_shift_x_; }
+  std::int64_t latticeShiftY() const { return lattice_shift_y_; }
+
+  /// Placement only (size, resolution, origin). The lattice anchor is not compared: two grids at
+  /// the same origin differ in it by rounding at most.
   bool operator==(const GridGeometry& o) const {
     return size_x_ == o.size_x_ && size_y_ == o.size_y_ && resolution_ == o.resolution_ &&
            origin_x_ == o.origin_x_ && origin_y_ == o.origin_y_;
@@ -101,11 +126,20 @@ class GridGeometry {
   bool operator!=(const GridGeometry& o) const { return !(*this == o); }
 
  private:
+  /// floor(units) - shift as a double (exact below 2^53; out-of-range values stay out of range).
+  static double cellCoordinate(double units, std::int64_t shift) {
+    return std::floor(units) - static_cast<double>(shift);
+  }
+
   int size_x_ = 0;
   int size_y_ = 0;
   double resolution_ = 0.05;
   double origin_x_ = 0.0;
   double origin_y_ = 0.0;
+  double lattice_x_ = 0.0;  ///< the origin the grid was built with
+  double lattice_y_ = 0.0;
+  std::int64_t lattice_shift_x_ = 0;  ///< whole cells the origin moved since
+  std::int64_t lattice_shift_y_ = 0;
 };
 
 }  // namespace downstream_perception

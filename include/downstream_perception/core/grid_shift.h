@@ -36,11 +36,11 @@ void shiftGridData(std::vector<T>* cells, int size_x, int size_y, int dx, int dy
   cells->swap(shifted);
 }
 
-/// The geometry after such a shift: same size, origin moved by (dx, dy) cells (in double: no
-/// integer overflow). Throws std::invalid_argument if the new origin is not finite.
+/// The geometry after such a shift (GridGeometry::shiftedBy: the origin moves by (dx, dy) cells,
+/// the lattice cells are counted on stays). Throws std::invalid_argument if the new origin is
+/// not finite.
 inline GridGeometry shiftedGeometry(const GridGeometry& g, int dx, int dy) {
-  return GridGeometry(g.sizeX(), g.sizeY(), g.resolution(), g.originX() + dx * g.resolution(),
-                      g.originY() + dy * g.resolution());
+  return g.shiftedBy(dx, dy);
 }
 
 }  // namespace downstream_perception

@@ -9,7 +9,12 @@
 //    end point. This is what the obstacle layer clears with: Bresenham between cell centres skips
 //    cells a diagonal beam really crosses (and visits some it does not), which leaves uncleared
 //    specks in free space. Where the segment passes exactly through a cell corner, the walker steps
-//    in x first (the two side cells are touched only at a point, so either choice is exact).
+//    diagonally: the two side cells are touched at a single point, their interiors are not
+//    crossed, so neither is visited (visiting one of them, as an x-first tie-break did, clears a
+//    cell on one side of the beam only and depends on the beam's direction).
+//    The start and end cells are the cells GridGeometry::worldToCell gives for the two points
+//    (floor on the grid's lattice: a point exactly on an edge is in the cell above it), so the
+//    walk ends in exactly the cell a hit at its end point marks.
 #pragma once
 
 #include <algorithm>
@@ -73,9 +78,13 @@ bool clipSegmentToGrid(const GridGeometry& grid, double* x0, double* y0, double*
 /// Why no per-axis guards are needed: with exact integer arithmetic the walk crosses edges in the
 /// true order of their crossing parameters t, and the first stepsLeft() crossings are exactly the
 /// ones with t <= 1, i.e. steps_x vertical and steps_y horizontal edges (an end point lying on an
-/// edge is entered at t = 1 when moving up, never crossed when moving down). A corner inside the
-/// segment may go either way (the two side cells are touched at a single point, so either is
-/// exact); a corner at t = 1 must step along the axis that moves up (see tie_to_y).
+/// edge is entered at t = 1 when moving up, never crossed when moving down). A corner (a tie,
+/// err == tie) is crossed diagonally, both edges in one step, when two or more crossings are left:
+/// inside the segment both edges are crossed at that t, and at t = 1 that is the case only when
+/// both axes move up (then the end cell is the diagonal one). With one crossing left the corner is
+/// at t = 1 and only the axis that moves up crosses its edge; tie = 1 makes the tie fall on that
+/// axis when it is y. A diagonal step is one visit for two crossings: stepsLeft() counts
+/// crossings, the walk may visit fewer cells.
 struct RayWalk {
   static constexpr int kShift = 20;
   static constexpr std::int64_t kOne = std::int64_t{1} << kShift;
@@ -86,9 +95,11 @@ struct RayWalk {
   int sy = 1;
   int steps_x = 0;  ///< x steps from the start cell to the end cell
   int steps_y = 0;
-  std::int64_t err = 0;         ///< <= 0: the next edge crossed is vertical (step in x)
+  std::int64_t err = 0;         ///< <= tie: the next edge crossed is vertical (step in x)
   std::int64_t err_step_x = 0;  ///< added to err on an x step
   std::int64_t err_step_y = 0;  ///< subtracted from err on a y step
+  std::int64_t tie = 0;         ///< err == tie: the next crossing is a corner (both edges)
+  bool corners = false;         ///< whether err can ever equal tie (else no corner is crossed)
 
   /// The segment (x0,y0)-(x1,y1) should lie inside the grid (clip it first). Whatever it is, the
   /// fixed-point ends are clamped into the grid (NaN to 0), so the walk never leaves the grid:
@@ -98,17 +109,10 @@ struct RayWalk {
   /// product below by 2^62, so the int64 arithmetic cannot overflow.
   RayWalk(const GridGeometry& grid, double x0, double y0, double x1, double y1) {
     const double scale = static_cast<double>(kOne) / grid.resolution();
-    // Round to nearest; the clamped coordinates are non-negative, so truncating v + 0.5 is the
-    // rounding (and avoids a libm call per coordinate). Clamped as doubles: casting an
-    // out-of-range double to int64 is undefined.
-    const auto fixed = [scale](double v, int cells) {
-      const double hi = static_cast<double>(std::max<std::int64_t>(0, cells * kOne - 1));
-      return static_cast<std::int64_t>(std::max(0.0, std::min(v * scale + 0.5, hi)));
-    };
-    const std::int64_t fx0 = fixed(x0 - grid.originX(), grid.sizeX());
-    const std::int64_t fy0 = fixed(y0 - grid.originY(), grid.sizeY());
-    const std::int64_t fx1 = fixed(x1 - grid.originX(), grid.sizeX());
-    const std::int64_t fy1 = fixed(y1 - grid.originY(), grid.sizeY());
+    const std::int64_t fx0 = fixedX(grid, x0, scale);
+    const std::int64_t fy0 = fixedY(grid, y0, scale);
+    const std::int64_t fx1 = fixedX(grid, x1, scale);
+    const std::int64_t fy1 = fixedY(grid, y1, scale);
     // Arithmetic shift = floor division for the (clamped, non-negative) coordinates.
     cx = static_cast<int>(fx0 >> kShift);
     cy = static_cast<int>(fy0 >> kShift);
@@ -123,17 +127,63 @@ struct RayWalk {
         sx > 0 ? (std::int64_t{cx} + 1) * kOne - fx0 : fx0 - std::int64_t{cx} * kOne;
     const std::int64_t first_y =
         sy > 0 ? (std::int64_t{cy} + 1) * kOne - fy0 : fy0 - std::int64_t{cy} * kOne;
-    // t_max_x <= t_max_y  <=>  first_x / adx <= first_y / ady  <=>  err <= 0. A segment with no
-    // x extent never crosses a vertical edge (err stays positive; err_step_y is 0 then).
-    // Ties (err == 0, a corner) step x, except when x moves down and y up: a corner at t = 1 then
-    // lies on the end cell's lower x edge, which must not be crossed, so the tie goes to y
-    // (err is an integer, so +1 moves only the ties).
-    const std::int64_t tie_to_y = (sx < 0 && sy > 0) ? 1 : 0;
-    err = adx == 0 ? std::int64_t{1} : first_x * ady - first_y * adx + tie_to_y;
+    // t_max_x <= t_max_y  <=>  first_x / adx <= first_y / ady  <=>  err <= tie. A segment with no
+    // x extent never crosses a vertical edge (err stays at 2, above any tie; err_step_y is 0).
+    // Ties (a corner) are err == tie: tie is 0, except when x moves down and y up: a corner at
+    // t = 1 then lies on the end cell's lower x edge, which must not be crossed, so the tie goes
+    // to y (err is an integer, so +1 moves only the ties).
+    tie = (sx < 0 && sy > 0) ? 1 : 0;
+    // A segment with no y extent never crosses a horizontal edge: err stays at -1, below any tie
+    // (first_y may be 0 there, which would make a false tie).
+    err = adx == 0   ? std::int64_t{2}
+          : ady == 0 ? std::int64_t{-1}
+                     : first_x * ady - first_y * adx + tie;
     err_step_x = kOne * ady;
     err_step_y = kOne * adx;
+    // err moves in multiples of kOne, so it can only ever equal tie if it starts congruent to it
+    // modulo kOne: true for segments between lattice-exact points (tests, simulated walls), all
+    // but never for measured rays. The others walk the loop without the corner test.
+    corners = adx != 0 && ady != 0 && ((err - tie) & (kOne - 1)) == 0;
     steps_x = cx > ex ? cx - ex : ex - cx;
     steps_y = cy > ey ? cy - ey : ey - cy;
+  }
+
+  /// A world coordinate in fixed point relative to the grid, clamped into the grid (NaN to 0).
+  /// Its cell is exactly the cell GridGeometry::worldToCell gives; only the fraction is rounded
+  /// (to 2^-20 cell, never across an edge). Fast path: (x - origin) * scale rounded, as precise
+  /// as the exact form to far below 2^-20 cell, so its cell is right whenever the point is more
+  /// than 2^-19 cell from an edge; nearer (points on edges: lattice-exact geometry) the exact form
+  /// is taken (a division, off the common path).
+  static std::int64_t fixedX(const GridGeometry& g, double x, double scale) {
+    return fixedAxis(x - g.originX(), scale, g.sizeX(),
+                     [&g, x] { return fixed(g.latticeUnitsX(x), g.latticeShiftX(), g.sizeX()); });
+  }
+  static std::int64_t fixedY(const GridGeometry& g, double y, double scale) {
+    return fixedAxis(y - g.originY(), scale, g.sizeY(),
+                     [&g, y] { return fixed(g.latticeUnitsY(y), g.latticeShiftY(), g.sizeY()); });
+  }
+  template <class Exact>
+  static std::int64_t fixedAxis(double offset, double scale, int cells, Exact&& exact) {
+    // Clamped as doubles: casting an out-of-range double to int64 is undefined. Non-negative
+    // after the clamp, so truncating v + 0.5 rounds (no libm call).
+    const double hi = static_cast<double>(std::max<std::int64_t>(0, cells * kOne - 1));
+    const auto f = static_cast<std::int64_t>(std::max(0.0, std::min(offset * scale + 0.5, hi)));
+    const std::int64_t sub = f & (kOne - 1);
+    if (__builtin_expect(sub < 2 || sub > kOne - 2, 0)) return exact();
+    return f;
+  }
+
+  /// The exact form: a lattice coordinate u (GridGeometry::latticeUnitsX/Y) in fixed point
+  /// relative to the grid, clamped into [0, cells) (NaN to 0); its cell is floor(u) - shift,
+  /// exactly as GridGeometry::worldToCell floors.
+  static std::int64_t fixed(double u, std::int64_t shift, int cells) {
+    const double lo = static_cast<double>(shift);
+    const double c = std::max(lo, std::min(u, lo + static_cast<double>(cells)));  // NaN to lo
+    auto whole = static_cast<std::int64_t>(c);  // |c| < 2^63: c lies in [lo, lo + cells]
+    whole -= static_cast<double>(whole) > c ? 1 : 0;
+    const double fraction = c - static_cast<double>(whole);  // exact, in [0, 1)
+    const auto sub = std::min(static_cast<std::int64_t>(fraction * kOne + 0.5), kOne - 1);
+    return std::min((whole - shift) * kOne + sub, std::int64_t{cells} * kOne - 1);
   }
 
   int stepsLeft() const { return steps_x + steps_y; }
@@ -149,7 +199,13 @@ struct RayWalk {
     std::int64_t e = err;
     for (int left = stepsLeft(); left > 0; --left) {
       visit(x, y);
-      if (e <= 0) {
+      if (corners && e == tie &&
+          left >= 2) {  // a corner: both edges in one step (see the struct comment)
+        x += sx;
+        y += sy;
+        e += err_step_x - err_step_y;
+        --left;
+      } else if (e <= 0) {
         x += sx;
         e += err_step_x;
       } else {

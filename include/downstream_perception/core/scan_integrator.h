@@ -133,6 +133,14 @@ class ScanIntegrator {
   void beamFromDirection(double origin_x, double origin_y, double cos_dir, double sin_dir,
                          double range, double range_min, double range_max,
                          std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
+  /// Same for a measured point (a cloud point, in the grid's frame): a return at its horizontal
+  /// distance from the origin whose hit, and the end of its clearing ray, is the point itself, so
+  /// the cell it marks is the cell containing it. A point at zero horizontal range (straight above
+  /// or below the sensor) is a return at range 0: it marks the sensor's own cell (if range_min
+  /// and obstacle_min_range are 0) and clears nothing, as costmap_2d marks it.
+  void beamToPoint(double origin_x, double origin_y, double point_x, double point_y,
+                   double range_min, double range_max, std::vector<BeamUpdate>* beams,
+                   IntegrationStats* stats) const;
 
   /// integrateBeams over beams made by the beamsFrom* calls; the beam counts of `decisions`
   /// (filled by those calls) are carried into the result.
@@ -144,6 +152,12 @@ class ScanIntegrator {
                              const Pose2D& sensor_pose);
 
  private:
+  /// The REP-117 decisions of beamFromDirection; `point` (or nullptr) is the measured point at
+  /// `range` along (c, s), used as the hit and the clearing end instead of recomputing it.
+  void makeBeam(double origin_x, double origin_y, double c, double s, double range,
+                double range_min, double range_max, const double* point,
+                std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
+
   ScanIntegratorConfig config_;
   std::vector<BeamUpdate> scratch_;
   std::vector<std::uint32_t> flagged_scratch_;
