@@ -297,8 +297,10 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   }
   std::string stale;
   for (const auto& layer : layered_costmap_->plugins()) {
-    if (layer->isEnabled() && !layer->isCurrent())
-      stale += (stale.empty() ? "" : ", ") + layer->name();
+    if (!layer->isEnabled() || layer->isCurrent()) continue;
+    std::string why = layer->notCurrentReason();
+    if (why.empty()) why = "layer '" + layer->name() + "' is not current";
+    stale += (stale.empty() ? "" : "; ") + why;
   }
   if (!errors.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, errors.front());
@@ -306,7 +308,7 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
                    "no layers: the costmap stays at its default value (set ~plugins)");
   } else if (!stale.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "layer(s) not current: " + stale);
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, stale);
   } else if (!param_warnings_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, param_warnings_.front());
   } else if (updates_ > 10 && achieved_hz < 0.8 * config_.update_frequency) {

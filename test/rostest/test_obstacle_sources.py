@@ -46,6 +46,13 @@ class Diagnostics:
                     return status
         return None
 
+    def costmap(self) -> DiagnosticStatus | None:
+        with self._lock:
+            for key, status in self._status.items():
+                if key.endswith(": costmap"):
+                    return status
+        return None
+
     def values(self, name: str) -> dict[str, str]:
         status = self.layer(name)
         return {} if status is None else {kv.key: kv.value for kv in status.values}
@@ -165,6 +172,15 @@ class ObstacleSourcesTest(unittest.TestCase):
         assert status is not None
         self.assertEqual(status.level, DiagnosticStatus.WARN)
         self.assertIn("source 'silent' (/os/silent)", status.message)
+        # The costmap's own summary names the source too, not just "a layer is not current".
+        self.assertTrue(
+            wait_until(
+                lambda: "source 'silent' (/os/silent)"
+                in getattr(self.diag.costmap(), "message", ""),
+                10.0,
+            ),
+            str(getattr(self.diag.costmap(), "message", None)),
+        )
 
     def test_6_wrong_typed_and_unknown_keys_are_warned(self) -> None:
         v = self.diag.values("obstacles")
