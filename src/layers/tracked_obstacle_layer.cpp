@@ -56,10 +56,19 @@ void TrackedObstacleLayer::reconfigure(TrackedObstacleLayerConfig& cfg, std::uin
   }
   std::string why = prediction.validate();
   if (!why.empty()) {
-    config_errors_.add(why + "; keeping the previous prediction settings (horizon " +
-                       toText(previous.prediction_horizon_s) + " s)");
+    config_errors_.set("prediction", why + "; keeping the previous prediction settings (horizon " +
+                                         toText(previous.prediction_horizon_s) + " s)");
     prediction = previous;
+  } else {
+    config_errors_.clear("prediction");
   }
+  // The server stores and publishes what this callback leaves in cfg: the values in use.
+  cfg.prediction_horizon_s = prediction.prediction_horizon_s;
+  cfg.uncertainty_sigmas = prediction.uncertainty_sigmas;
+  cfg.max_uncertainty_m = prediction.max_uncertainty_m;
+  cfg.min_object_size_m = prediction.min_object_size_m;
+  cfg.max_object_size_m = prediction.max_object_size_m;
+  cfg.max_speed_mps = prediction.max_speed_mps;
   TrackInboxConfig inbox = inbox_.config();
   const double previous_timeout = inbox.track_timeout_s;
   inbox.track_timeout_s = cfg.track_timeout_s;
@@ -67,9 +76,12 @@ void TrackedObstacleLayer::reconfigure(TrackedObstacleLayerConfig& cfg, std::uin
   inbox.include_coasting = cfg.include_coasting;
   why = inbox.validate();
   if (!why.empty()) {
-    config_errors_.add(why + "; keeping " + toText(previous_timeout) + " s");
+    config_errors_.set("track_timeout_s", why + "; keeping " + toText(previous_timeout) + " s");
     inbox.track_timeout_s = previous_timeout;
+  } else {
+    config_errors_.clear("track_timeout_s");
   }
+  cfg.track_timeout_s = inbox.track_timeout_s;
   inbox_.setConfig(inbox);
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -13,9 +13,11 @@ import math
 import threading
 import unittest
 
+import dynamic_reconfigure.client
 import numpy as np
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from tf2_ros import StaticTransformBroadcaster
 
 from downstream_perception.costmap_client import CostmapClient
@@ -130,6 +132,36 @@ class TrackedObstaclesTest(unittest.TestCase):
             wait_until(lambda: int((self.costmap.grid() > 0).sum()) == 0, 5.0),
             "the corridor stayed after the track timed out",
         )
+
+    def test_rejected_reconfigure_value_is_reverted_and_its_error_clears(self) -> None:
+        status: dict[str, DiagnosticStatus] = {}
+
+        def on_diag(msg: DiagnosticArray) -> None:
+            for st in msg.status:
+                status[st.name] = st
+
+        def layer() -> DiagnosticStatus | None:
+            return next((v for k, v in status.items() if k.endswith("layer tracked")), None)
+
+        sub = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
+        client = dynamic_reconfigure.client.Client("/costmap/tracked", timeout=20.0)
+        used = client.update_configuration({"prediction_horizon_s": -1.0})
+        self.assertEqual(
+            used["prediction_horizon_s"], HORIZON, "the server shows the refused value"
+        )
+        self.assertTrue(
+            wait_until(
+                lambda: layer() is not None and layer().level == DiagnosticStatus.ERROR, 15.0
+            )
+        )
+        client.update_configuration({"prediction_horizon_s": HORIZON})
+        self.assertTrue(
+            wait_until(
+                lambda: layer() is not None and layer().level != DiagnosticStatus.ERROR, 15.0
+            ),
+            str(layer()),
+        )
+        sub.unregister()
 
 
 if __name__ == "__main__":
