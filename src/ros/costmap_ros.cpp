@@ -4,6 +4,7 @@
 #include <tf2/utils.h>
 
 #include <chrono>
+#include <cmath>
 #include <sstream>
 
 #include "downstream_perception/config_errors.h"
@@ -149,6 +150,22 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
   }
   if (publisher_) publisher_->setAlwaysSendFull(next.always_send_full_costmap);
   config_ = next;
+  // The footprint's limits (readFootprint's): a refused value is reverted in the server.
+  ConfigErrors footprint_errors;
+  if (!std::isfinite(cfg.robot_radius) || cfg.robot_radius < 0.0 || cfg.robot_radius > 100.0) {
+    footprint_errors.set("robot_radius", "parameter ~robot_radius = " + toText(cfg.robot_radius) +
+                                             " is invalid (0..100 m); keeping the previous value");
+    pnh_.param("robot_radius", cfg.robot_radius, 0.46);
+  }
+  if (!std::isfinite(cfg.footprint_padding) || cfg.footprint_padding < 0.0 ||
+      cfg.footprint_padding > 10.0) {
+    footprint_errors.set("footprint_padding",
+                         "parameter ~footprint_padding = " + toText(cfg.footprint_padding) +
+                             " is invalid (0..10 m); keeping the previous value");
+    pnh_.param("footprint_padding", cfg.footprint_padding, 0.01);
+  }
+  for (const auto& msg : footprint_errors.messages()) ROS_ERROR("costmap: %s", msg.c_str());
+  setErrors(footprint_errors, {"robot_radius", "footprint_padding"});
   // The footprint parameters are read back from the parameter server, so set them first.
   double radius = 0.0;
   double padding = 0.0;
@@ -193,8 +210,8 @@ void CostmapRos::loadPlugins() {
 }
 
 void CostmapRos::auditKeys(ParamReader& params) {
-  params.known(
-      {"plugins", "static_map", "map_type", "footprint", "robot_radius", "footprint_padding"});
+  params.reconfigureKeys<CostmapConfig>();  // robot_radius, footprint_padding, ... type-checked
+  params.known({"plugins", "static_map", "map_type", "footprint"});
   params.unsupported("footprint_topic",
                      "the footprint is read from ~footprint / robot_radius (also on "
                      "dynamic_reconfigure) and published on ~footprint; no footprint subscriber");

@@ -144,8 +144,9 @@ class Costmap2dHostTest(unittest.TestCase):
 
     def test_a_rejected_reconfigure_value_is_reverted_and_its_error_clears(self) -> None:
         client = dynamic_reconfigure.client.Client("/robot/aliases", timeout=20.0)
-        used = client.update_configuration({"update_frequency": -1.0})
+        used = client.update_configuration({"update_frequency": -1.0, "robot_radius": -1.0})
         self.assertEqual(used["update_frequency"], 5.0, "the server shows the refused value")
+        self.assertEqual(used["robot_radius"], 0.46, "the server shows the refused radius")
         self.assertTrue(
             wait_until(lambda: "update_frequency" in self.diag("/robot/aliases").message, 20.0)
         )
