@@ -602,6 +602,82 @@ def garbage_se2(a: dict[str, Any], r: Any) -> str | None:
     return None
 
 
+# ----------------------------------------------------------------------------- static map
+def occupancy_array(g: Gen, shape: tuple[int, int]) -> Any:
+    """int8 occupancy of `shape`, or (hostile) a wrong one: 1-D, 3-D, empty, floats."""
+    good = g.rng.integers(-128, 128, size=shape).astype(np.int8)
+    if not g.chance(g.hostile):
+        return good
+    kind = g.pick(("1d", "3d", "empty", "float", "list"))
+    if kind == "1d":
+        return good.reshape(-1)
+    if kind == "3d":
+        return good.reshape((*shape, 1))
+    if kind == "empty":
+        return np.zeros((0, shape[1]), dtype=np.int8)
+    if kind == "float":
+        return g.floats(shape, -200, 200)
+    return good.tolist()
+
+
+def gen_static_map(rng: np.random.Generator) -> dict[str, Any]:
+    g = Gen(rng)
+    shape = (g.i(1, 40, 0.05, nasty=(0, 1)), g.i(1, 40, 0.05, nasty=(0, 1)))
+    return {
+        "config": {
+            "track_unknown_space": g.b(),
+            "use_maximum": g.b(),
+            "lethal_cost_threshold": g.i(-5, 120, nasty=INT32_NASTY),
+            "unknown_cost_value": g.i(-2, 255, nasty=INT32_NASTY),
+            "trinary_costmap": g.b(),
+            "max_cells": g.i(1, 4000, 0.1, nasty=(0, 1, 2**31, 2**63)),
+        },
+        "map": occupancy_array(g, shape),
+        "resolution": g.f(0.01, 1.0),
+        "origin": (g.f(-100, 100), g.f(-100, 100)),
+        "update_at": (g.i(-3, 45, nasty=NASTY_INTS), g.i(-3, 45, nasty=NASTY_INTS)),
+        "update": occupancy_array(g, (g.i(1, 12, 0.05, nasty=(0,)), g.i(1, 12, 0.05, nasty=(0,)))),
+    }
+
+
+def call_static_map(a: dict[str, Any]) -> Any:
+    c = core()
+    config = configure(c.StaticMapConfig(), a["config"])
+    values = c.static_map_values(a["map"], config)
+    m = c.StaticMap(config)
+    outcome = {"values": values, "set": None, "update": None}
+    try:
+        m.set_map(a["map"], a["resolution"], *a["origin"])
+        outcome["set"] = "ok"
+    except (ValueError, TypeError) as error:
+        outcome["set"] = str(error)
+    before = m.costs() if m.has_map else None
+    try:
+        m.apply_update(*a["update_at"], a["update"])
+        outcome["update"] = "ok"
+    except (ValueError, TypeError, OverflowError) as error:
+        outcome["update"] = str(error)
+    outcome["before"], outcome["after"], outcome["has_map"] = before, m.costs(), m.has_map
+    return outcome
+
+
+def garbage_static_map(a: dict[str, Any], r: Any) -> str | None:
+    values = r["values"]
+    if values.dtype != np.uint8 or values.size != np.asarray(a["map"], dtype=object).size:
+        return f"static_map_values gave {values.dtype} of {values.size} values"
+    if r["set"] != "ok" and r["has_map"]:
+        return f"a refused map ({r['set']}) left a map"
+    if (
+        r["update"] != "ok"
+        and r["before"] is not None
+        and not np.array_equal(r["before"], r["after"])
+    ):
+        return f"a refused update ({r['update']}) changed the map"
+    if r["set"] == "ok" and r["after"].shape != np.shape(a["map"]):
+        return f"costs of shape {r['after'].shape} for a map of {np.shape(a['map'])}"
+    return None
+
+
 # ----------------------------------------------------------------------------- costs, inflation
 def call_occupancy_table(a: dict[str, Any]) -> Any:
     return core().occupancy_table()
@@ -1689,6 +1765,13 @@ def binding_targets() -> list[Target]:
                 "normalize_angle",
                 "shortest_angular_distance",
             ),
+        ),
+        Target(
+            "static_map",
+            gen_static_map,
+            call_static_map,
+            garbage_static_map,
+            ("StaticMapConfig", "static_map_values", "StaticMap"),
         ),
         Target(
             "occupancy_table",

@@ -2,7 +2,7 @@
 # Debian's python3 must come first (pyenv or a venv would hide rospy and catkin_pkg).
 export PATH="/usr/bin:/bin:$PATH"
 export ROS_HOSTNAME=localhost
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+REPO="$(cd -P "$(dirname "${BASH_SOURCE[0]}")" && cd .. && pwd)"  # -P: the repository, also when reached through the workspace's links
 WS="$REPO/.ws"
 export ROS_HOME="$WS/ros_home"
 export REPO WS

@@ -28,6 +28,7 @@ class CostmapClient:
         self._last_full: np.ndarray | None = None
         self.full_grids = 0
         self.updates = 0
+        self.updates_dropped = 0  # updates that did not fit the current grid
         self.last_change_wall = 0.0  # time.time() of the last full grid or update
         rospy.Subscriber(topic, OccupancyGrid, self._on_full, queue_size=10)
         rospy.Subscriber(f"{topic}_updates", OccupancyGridUpdate, self._on_update, queue_size=100)
@@ -45,6 +46,16 @@ class CostmapClient:
         with self._lock:
             if self._grid is None:
                 return  # an update before any full grid cannot be placed
+            rows, cols = self._grid.shape
+            if (
+                msg.x + msg.width > cols
+                or msg.y + msg.height > rows
+                or len(msg.data) != msg.width * msg.height
+            ):
+                # An update for another size: one sent before a resize that arrived after the
+                # new full grid (two topics, no order between them). Dropped, as rviz does.
+                self.updates_dropped += 1
+                return
             patch = np.asarray(msg.data, dtype=np.int8).reshape(msg.height, msg.width)
             self._grid[msg.y : msg.y + msg.height, msg.x : msg.x + msg.width] = patch
             self.updates += 1

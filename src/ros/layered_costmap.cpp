@@ -32,12 +32,16 @@ CellBounds LayeredCostmap::updateMap(double robot_x, double robot_y, double robo
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   have_robot_pose_ = have_robot_pose;
   if (rolling_window_ && have_robot_pose) {
-    // Robot-centred, snapped to whole cells so that cell contents never get resampled.
+    // Robot-centred, snapped to whole cells so that cell contents never get resampled. The rule
+    // is costmap_2d's (LayeredCostmap::updateMap + Costmap2D::updateOrigin), quirks included:
+    // its size in metres is (cells - 0.5) * resolution and the shift truncates toward zero, so
+    // a rolling window here lies on the same cells as costmap_2d's for the same robot poses.
     const GridGeometry& g = master_.geometry();
-    const int dx = static_cast<int>(
-        std::lround((robot_x - 0.5 * g.sizeXMetres() - g.originX()) / g.resolution()));
-    const int dy = static_cast<int>(
-        std::lround((robot_y - 0.5 * g.sizeYMetres() - g.originY()) / g.resolution()));
+    const double res = g.resolution();
+    const double new_origin_x = robot_x - (g.sizeX() - 0.5) * res / 2.0;
+    const double new_origin_y = robot_y - (g.sizeY() - 0.5) * res / 2.0;
+    const int dx = static_cast<int>((new_origin_x - g.originX()) / res);
+    const int dy = static_cast<int>((new_origin_y - g.originY()) / res);
     if (dx != 0 || dy != 0) {
       master_.shift(dx, dy);
       for (auto& plugin : plugins_) plugin->shiftOrigin(dx, dy);

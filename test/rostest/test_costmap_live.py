@@ -207,7 +207,12 @@ class CostmapLiveTest(unittest.TestCase):
     def test_6_rolling_window_follows_the_robot(self) -> None:
         self.robot.resume()
         self.assertTrue(
-            wait_until(lambda: self.rolling.received and self.rolling.origin()[0] == -2.0)
+            # costmap_2d's rule: origin 0 + whole cells toward robot - (80 - 0.5) * 0.05 / 2 =
+            # -1.9875, truncated toward zero: -39 cells, -1.95 m.
+            wait_until(
+                lambda: self.rolling.received and abs(self.rolling.origin()[0] + 1.95) < 1e-6
+            ),
+            f"rolling origin {self.rolling.origin() if self.rolling.received else None}",
         )
         for x in np.arange(0.05, 1.0001, 0.05):
             self.robot.move_to(float(x))
