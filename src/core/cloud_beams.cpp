@@ -23,23 +23,37 @@ std::string CloudBeamsConfig::validate() const {
 
 namespace {
 
-// The merge key of a lattice coordinate: floor((w - anchor) / resolution), exactly the floor
-// GridGeometry takes (so the key's cell is the cell the beam's hit marks), without a division per
-// point. The product with the reciprocal is within 2 ulp of the quotient: below 2^31 cells that
-// is under 2^-20 cell, so its floor is the quotient's unless it lies within 2^-19 cell of an
-// integer (a point on a cell edge, e.g. a simulated wall on the lattice); there, and far out, the
-// division decides. Clamped to 32 bits: |key| < 2^31 holds every cell of any grid; points beyond
-// are far outside it and only clear.
-inline std::int64_t latticeKey(double offset, double inv_resolution, double resolution) {
-  const double u = offset * inv_resolution;
-  const double whole = std::floor(u);
-  // fraction u - whole in (2^-19, 1 - 2^-19), as one compare
-  if (std::abs(u - whole - 0.5) < 0.5 - 0x1p-19 && std::abs(u) < 0x1p31) {
-    return static_cast<std::int64_t>(whole);
+// The merge key of a lattice coordinate on one axis: floor((w - anchor) / resolution), exactly
+// the floor GridGeometry takes (so the key's cell is the cell the beam's hit marks), without a
+// division per point. The product with the reciprocal is within 2 ulp of the quotient: below 2^31
+// cells that is under 2^-20 cell, so its floor is the quotient's unless it lies within 2^-19 cell
+// of an integer (a point on a cell edge, e.g. a simulated wall on the lattice); there, and far
+// out, the division decides, and its last answer is kept (a wall on an edge gives the same
+// coordinate point after point). Clamped to 32 bits: |key| < 2^31 holds every cell of any grid;
+// points beyond are far outside it and only clear.
+struct LatticeAxis {
+  double anchor;
+  double resolution;
+  double inv_resolution;
+  double last_offset = std::numeric_limits<double>::quiet_NaN();
+  std::int64_t last_key = 0;
+
+  std::int64_t key(double w) {
+    const double offset = w - anchor;
+    const double u = offset * inv_resolution;
+    const double whole = std::floor(u);
+    // fraction u - whole in (2^-19, 1 - 2^-19), as one compare
+    if (std::abs(u - whole - 0.5) < 0.5 - 0x1p-19 && std::abs(u) < 0x1p31) {
+      return static_cast<std::int64_t>(whole);
+    }
+    if (offset != last_offset) {
+      last_offset = offset;
+      last_key = static_cast<std::int64_t>(
+          std::clamp(std::floor(offset / resolution), -0x1p31, 0x1p31 - 1.0));
+    }
+    return last_key;
   }
-  return static_cast<std::int64_t>(
-      std::clamp(std::floor(offset / resolution), -0x1p31, 0x1p31 - 1.0));
-}
+};
 
 }  // namespace
 
@@ -55,9 +69,10 @@ void beamsFromCloud(const ScanIntegrator& integrator, const CloudBeamsConfig& co
   // The grid's lattice: cell = floor((w - anchor) / resolution) - shift (GridGeometry). The
   // shift is the same for every point, so floor(...) alone is the key.
   const double resolution = merge ? config.merge_grid->resolution() : 1.0;
-  const double inv_resolution = 1.0 / resolution;
-  const double anchor_x = merge ? config.merge_grid->latticeAnchorX() : 0.0;
-  const double anchor_y = merge ? config.merge_grid->latticeAnchorY() : 0.0;
+  LatticeAxis axis_x{merge ? config.merge_grid->latticeAnchorX() : 0.0, resolution,
+                     1.0 / resolution};
+  LatticeAxis axis_y{merge ? config.merge_grid->latticeAnchorY() : 0.0, resolution,
+                     1.0 / resolution};
   tsl::robin_set<std::uint64_t> seen;
   if (merge) seen.reserve(4096);
   for (std::size_t k = 0; k < count; ++k) {
@@ -74,8 +89,8 @@ void beamsFromCloud(const ScanIntegrator& integrator, const CloudBeamsConfig& co
       continue;
     }
     if (merge) {
-      const std::int64_t cx = latticeKey(q.x() - anchor_x, inv_resolution, resolution);
-      const std::int64_t cy = latticeKey(q.y() - anchor_y, inv_resolution, resolution);
+      const std::int64_t cx = axis_x.key(q.x());
+      const std::int64_t cy = axis_y.key(q.y());
       const std::uint64_t key =
           (static_cast<std::uint64_t>(cx) << 32) ^ (static_cast<std::uint64_t>(cy) & 0xffffffffu);
       if (!seen.insert(key).second) {
