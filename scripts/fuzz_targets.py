@@ -508,7 +508,7 @@ def gen_scan_integrate_cloud(rng: np.random.Generator) -> dict[str, Any]:
         "grid_from_sensor": transform,
         "min_obstacle_height": g.f(-0.5, 0.5, 0.1),
         "max_obstacle_height": g.f(0.5, 3, 0.1),
-        "merge_cell_m": g.f(0, 0.2, 0.15) if g.b() else 0.0,
+        "merge_cells": g.b(),
     }
 
 
@@ -516,7 +516,7 @@ def call_scan_integrate_cloud(a: dict[str, Any]) -> Any:
     integrator, grid, valid = make_integrator(a)
     stats = integrator.integrate_cloud(
         grid, a["points"], a["grid_from_sensor"], a["min_obstacle_height"],
-        a["max_obstacle_height"], a["merge_cell_m"],
+        a["max_obstacle_height"], a["merge_cells"],
     )  # fmt: skip
     return {"valid": valid, "stats": stats, "grid": grid}
 

@@ -326,7 +326,7 @@ void runCloud(int iters) {
     return std::make_tuple(medianOf(beams_ms), medianOf(integrate_ms), beams.size());
   };
   CloudBeamsConfig merged = cloud;
-  merged.merge_cell_m = geometry.resolution();
+  merged.merge_grid = geometry;
   const auto [merged_beams_ms, merged_integrate_ms, merged_beams] = run(merged);
   const auto [beams_ms, integrate_ms, beams_in_band] = run(cloud);
   std::printf(

@@ -68,6 +68,7 @@ void LogOddsObstacleLayer::onInitialize() {
   reader.known({"obstacle_range", "raytrace_range"});
   grid_ = LogOddsGrid(layered_costmap_->costmap().geometry(), grid_config_);
   readSources(names);
+  setMergeGrids();
   {
     std::istringstream stream(names);
     std::string name;
@@ -325,8 +326,6 @@ void LogOddsObstacleLayer::readSources(const std::string& names) {
       config_errors_.add("source '" + name + "': " + why + "; source ignored");
       continue;
     }
-    // One beam per grid cell of a cloud: the same cells, a fraction of the ray walks.
-    config.cloud.merge_cell_m = layered_costmap_->costmap().geometry().resolution();
     auto on_observation = [this](ObservationSource& source, const Observation& observation) {
       integrate(source, observation);
     };
@@ -523,7 +522,20 @@ void LogOddsObstacleLayer::matchSize() {
     if (grid_.geometry() != g) grid_.resize(g);
     evidence_box_ = CellBounds{};
   }
+  setMergeGrids();
   markAllDirty();
+}
+
+void LogOddsObstacleLayer::setMergeGrids() {
+  // One beam per grid cell of a cloud: the same cells, a fraction of the ray walks. The cells
+  // must be this grid's (not squares from the world origin: see CloudBeamsConfig::merge_grid).
+  // A cloud converted just before a resize merges on the old cells once.
+  GridGeometry geometry;
+  {
+    std::lock_guard<std::mutex> lock(grid_mutex_);
+    geometry = grid_.geometry();
+  }
+  for (auto& source : sources_) source->setMergeGrid(geometry);
 }
 
 void LogOddsObstacleLayer::shiftOrigin(int dx, int dy) {

@@ -119,6 +119,16 @@ std::string ObservationSource::noPublisherReason(double grace_s) const {
   return "source '" + name_ + "': no publisher on " + resolvedTopic() + " (" + dataType() + ")";
 }
 
+void ObservationSource::setMergeGrid(const GridGeometry& grid) {
+  std::lock_guard<std::mutex> lock(merge_grid_mutex_);
+  merge_grid_ = grid;
+}
+
+std::optional<GridGeometry> ObservationSource::mergeGrid() const {
+  std::lock_guard<std::mutex> lock(merge_grid_mutex_);
+  return merge_grid_;
+}
+
 CloudBeamsConfig ObservationSource::heightBand() const {
   CloudBeamsConfig band = config_.cloud;
   band.max_obstacle_height = std::min(band.max_obstacle_height, mark_max_z_.load());

@@ -73,7 +73,8 @@ void PointCloudSource::onCloud(const sensor_msgs::PointCloud2& msg) {
 
   Observation obs;
   obs.stamp = msg.header.stamp;
-  const CloudBeamsConfig band = heightBand();
+  CloudBeamsConfig band = heightBand();
+  band.merge_grid = mergeGrid();
   // An empty cloud may still claim 2^32 - 1 rows of nothing: no loop over them.
   const std::uint32_t rows = msg.width == 0 ? 0 : msg.height;
   for (std::uint32_t row = 0; row < rows; ++row) {

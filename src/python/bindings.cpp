@@ -293,7 +293,7 @@ PYBIND11_MODULE(_core, m) {
           [](ScanIntegrator& self, LogOddsGrid& grid,
              py::array_t<float, py::array::c_style | py::array::forcecast> points,
              py::array_t<double, py::array::c_style | py::array::forcecast> grid_from_sensor,
-             double min_obstacle_height, double max_obstacle_height, double merge_cell_m) {
+             double min_obstacle_height, double max_obstacle_height, bool merge_cells) {
             if (points.ndim() != 2 || points.shape(1) != 3) {
               throw std::invalid_argument("points must be an (N, 3) array");
             }
@@ -301,7 +301,10 @@ PYBIND11_MODULE(_core, m) {
                 grid_from_sensor.shape(1) != 4) {
               throw std::invalid_argument("grid_from_sensor must be a 4 x 4 matrix");
             }
-            const CloudBeamsConfig config{min_obstacle_height, max_obstacle_height, merge_cell_m};
+            CloudBeamsConfig config;
+            config.min_obstacle_height = min_obstacle_height;
+            config.max_obstacle_height = max_obstacle_height;
+            if (merge_cells) config.merge_grid = grid.geometry();
             const std::string why = config.validate();
             if (!why.empty()) throw std::invalid_argument(why);
             Eigen::Matrix4d m;
@@ -319,10 +322,10 @@ PYBIND11_MODULE(_core, m) {
           },
           py::arg("grid"), py::arg("points"), py::arg("grid_from_sensor"),
           py::arg("min_obstacle_height") = 0.0, py::arg("max_obstacle_height") = 2.0,
-          py::arg("merge_cell_m") = 0.0,
+          py::arg("merge_cells") = false,
           "Integrates an (N, 3) point cloud in the sensor frame placed by the 4 x 4 transform "
           "grid_from_sensor; points outside the height band (grid frame z, m) are skipped; with "
-          "merge_cell_m > 0 one beam per merge cell.");
+          "merge_cells one beam per grid cell (the first point in it).");
 
   // ----------------------------------------------------------------- SE(2)
   py::class_<Pose2D>(m, "Pose2D")

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/cloud_beams.h"
@@ -100,9 +103,9 @@ TEST(CloudBeams, MergeCellsGiveOneBeamPerCellAndTheSameMarks) {
   const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   CloudBeamsConfig merged;
   merged.min_obstacle_height = -1.0;
-  merged.merge_cell_m = 0.05;
+  merged.merge_grid = GridGeometry(100, 100, 0.05, -2.5, -2.5);
   CloudBeamsConfig each = merged;
-  each.merge_cell_m = 0.0;
+  each.merge_grid.reset();
   std::vector<BeamUpdate> merged_beams, each_beams;
   IntegrationStats merged_stats, each_stats;
   const auto* data = reinterpret_cast<const unsigned char*>(&cloud[0].x);
@@ -123,5 +126,84 @@ TEST(CloudBeams, MergeCellsGiveOneBeamPerCellAndTheSameMarks) {
     EXPECT_EQ(a.units(a.geometry().index(c.x, c.y)), b.units(b.geometry().index(c.x, c.y)));
     EXPECT_GT(a.units(a.geometry().index(c.x, c.y)), 0);
   }
-  EXPECT_FALSE((CloudBeamsConfig{0.0, 1.0, -0.05}).validate().empty());
+  EXPECT_FALSE((CloudBeamsConfig{1.0, 0.0, std::nullopt}).validate().empty());
+}
+
+// The merge cells are the grid's cells: a grid whose origin is not a multiple of its resolution
+// (-2.97 m at 0.05 m), or that rolled by whole cells since it was built, must still get a mark in
+// every cell that holds an in-band point (squares counted from the world origin put points of two
+// neighbouring cells into one square, and the second cell went unmarked).
+TEST(CloudBeams, MergeCellsAreTheGridsCellsWhateverItsOriginAndShifts) {
+  ScanIntegratorConfig ic;
+  ic.obstacle_max_range = 5e3;  // the sensor sits at the world origin, the grids up to 1.5 km off
+  ic.raytrace_max_range = 5e3;
+  ScanIntegrator integrator(ic);
+  std::mt19937 rng(5);
+  struct Case {
+    double resolution, origin_x, origin_y;
+    std::vector<std::pair<int, int>> shifts;  ///< rolling-window shifts applied after building
+  };
+  const std::vector<Case> cases = {
+      {0.05, -2.97, -2.97, {}},
+      {0.05, -2.5, -2.5, {}},  // aligned to the world: the control
+      {0.05, 0.013, -1.0071, {{3, -2}}},
+      {0.1, 0.33, -7.77, {{1, 1}, {-5, 2}, {7, -3}}},
+      {0.025, -1.0123, 0.0049, {{40, 0}, {-1, 13}}},
+      {0.3, 12.1, -3.05, {{-2, -2}}},
+      {0.05, 1000.0371, -999.9913, {{2, 2}, {2, 2}, {2, 2}, {-1, 5}}},
+      {0.07, -3.1, 2.2, {{11, -4}, {3, 3}}},
+  };
+  for (const Case& c : cases) {
+    GridGeometry geometry(40, 30, c.resolution, c.origin_x, c.origin_y);
+    for (const auto& [dx, dy] : c.shifts) geometry = geometry.shiftedBy(dx, dy);
+    SCOPED_TRACE(::testing::Message()
+                 << "resolution " << c.resolution << " origin (" << geometry.originX() << ", "
+                 << geometry.originY() << "), " << c.shifts.size() << " shifts");
+    std::uniform_real_distribution<double> ux(geometry.originX(),
+                                              geometry.originX() + geometry.sizeXMetres());
+    std::uniform_real_distribution<double> uy(geometry.originY(),
+                                              geometry.originY() + geometry.sizeYMetres());
+    std::vector<PointXYZI> cloud;
+    for (int k = 0; k < 6000; ++k) {
+      cloud.push_back({static_cast<float>(ux(rng)), static_cast<float>(uy(rng)), 0.5f, 0.0f});
+    }
+    // And points on (the float nearest to) each cell edge and one float either side of it, where
+    // the merge cell and the grid cell must agree to the last bit.
+    for (int k = 0; k <= geometry.sizeX(); ++k) {
+      const auto edge = static_cast<float>(geometry.originX() + k * geometry.resolution());
+      const auto row_y = static_cast<float>(geometry.originY() + 3.5 * geometry.resolution());
+      for (const float x :
+           {std::nextafter(edge, -INFINITY), edge, std::nextafter(edge, INFINITY)}) {
+        cloud.push_back({x, row_y, 0.5f, 0.0f});
+      }
+    }
+    for (int k = 0; k <= geometry.sizeY(); ++k) {
+      const auto edge = static_cast<float>(geometry.originY() + k * geometry.resolution());
+      const auto column_x = static_cast<float>(geometry.originX() + 5.5 * geometry.resolution());
+      for (const float y :
+           {std::nextafter(edge, -INFINITY), edge, std::nextafter(edge, INFINITY)}) {
+        cloud.push_back({column_x, y, 0.5f, 0.0f});
+      }
+    }
+    CloudBeamsConfig cc;
+    cc.merge_grid = geometry;
+    std::vector<BeamUpdate> beams;
+    IntegrationStats stats;
+    beamsFromCloud(integrator, cc, reinterpret_cast<const unsigned char*>(&cloud[0].x),
+                   cloud.size(), sizeof(PointXYZI), Eigen::Isometry3d::Identity(), &beams, &stats);
+    LogOddsGrid grid(geometry);
+    integrator.integrate(grid, beams, stats);
+    std::set<std::size_t> holding;  // cells holding a point (the sensor is at the world origin)
+    for (const PointXYZI& p : cloud) {
+      CellIndex cell;
+      if (geometry.worldToCell(p.x, p.y, &cell)) holding.insert(geometry.index(cell.x, cell.y));
+    }
+    ASSERT_GT(holding.size(), 600u);
+    std::size_t unmarked = 0;
+    for (const std::size_t i : holding) unmarked += grid.units(i) <= 0 ? 1 : 0;
+    EXPECT_EQ(unmarked, 0u) << "of " << holding.size() << " cells holding a point";
+    // Merging happened: about one beam per cell (points on the grid's border may fall outside).
+    EXPECT_LT(beams.size(), holding.size() + 100);
+    EXPECT_EQ(beams.size() + stats.points_merged, cloud.size());
+  }
 }

@@ -9,17 +9,19 @@
 // within obstacle_max_range and clears from the sensor to it, like a laser beam; a point straight
 // above or below the sensor (zero horizontal range) marks the sensor's own cell and clears
 // nothing, as costmap_2d marks it. Non-finite points
-// (NaN from depth holes) are invalid and ignored. With merge_cell_m > 0 only the first point
-// per merge cell casts a beam: the same cells are marked, and the clearing rays differ from the
-// per-point ones only within that cell's width at the far end.
+// (NaN from depth holes) are invalid and ignored. With a merge grid only the first point per
+// cell of that grid casts a beam: the same cells are marked, and the clearing rays differ from
+// the per-point ones only within that cell's width at the far end.
 #pragma once
 
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "downstream_perception/core/grid_geometry.h"
 #include "downstream_perception/core/scan_integrator.h"
 
 namespace downstream_perception {
@@ -27,10 +29,13 @@ namespace downstream_perception {
 struct CloudBeamsConfig {
   double min_obstacle_height = 0.0;  ///< m, in the grid's frame
   double max_obstacle_height = 2.0;  ///< m, in the grid's frame
-  /// m: points whose horizontal position falls in the same square of this size give one beam
+  /// The grid the beams are integrated into, if set: points in the same cell of it give one beam
   /// (a depth camera puts hundreds of pixels into one grid cell; their rays are the same to a
-  /// cell). 0 = one beam per point. The obstacle layer sets it to the grid resolution.
-  double merge_cell_m = 0.0;
+  /// cell). Unset = one beam per point. The cells are the grid's own (GridGeometry's lattice, so
+  /// any rolling-window shift of the same grid gives the same cells): squares of the resolution
+  /// counted from the world origin instead would put two points of neighbouring cells into one
+  /// square whenever the origin is not a multiple of the resolution, and leave one cell unmarked.
+  std::optional<GridGeometry> merge_grid;
 
   /// Empty if valid, else the reason.
   std::string validate() const;

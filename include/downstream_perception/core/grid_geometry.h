@@ -113,6 +113,9 @@ class GridGeometry {
   /// floors (the ray walker's too, so that its end cell is the cell a hit marks).
   double latticeUnitsX(double wx) const { return (wx - lattice_x_) / resolution_; }
   double latticeUnitsY(double wy) const { return (wy - lattice_y_) / resolution_; }
+  /// The lattice anchor (m): the origin the grid was built with; shifts keep it.
+  double latticeAnchorX() const { return lattice_x_; }
+  double latticeAnchorY() const { return lattice_y_; }
   /// Whole cells the origin moved since the anchor: cell index = floor(lattice units) - shift.
   std::int64_t latticeShiftX() const { return lattice_shift_x_; }
   std::int64_t latticeShiftY() const { return lattice_shift_y_; }

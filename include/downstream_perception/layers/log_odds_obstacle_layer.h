@@ -71,6 +71,8 @@ class LogOddsObstacleLayer : public Layer {
   using ReconfigureServer = dynamic_reconfigure::Server<LogOddsObstacleLayerConfig>;
   void reconfigure(LogOddsObstacleLayerConfig& config, std::uint32_t level);
   void readSources(const std::string& names);
+  /// Gives every source the grid's current geometry (CloudBeamsConfig::merge_grid).
+  void setMergeGrids();
   /// The marking limit min(max_obstacle_height, extra_mark_limit_z_) into every source; WARNs
   /// once per source whose own band reaches above it.
   void applyMarkLimit(double max_obstacle_height);

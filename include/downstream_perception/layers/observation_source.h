@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,12 @@ class ObservationSource {
   void setMarkHeightLimit(double max_z) { mark_max_z_ = max_z; }
   /// [min_obstacle_height, min(max_obstacle_height, the layer's marking limit)] (m).
   CloudBeamsConfig heightBand() const;
+  /// The geometry of the grid this source's observations are integrated into: a cloud gives one
+  /// beam per cell of it (CloudBeamsConfig::merge_grid). The layer sets it whenever its grid is
+  /// made or resized; rolling-window shifts keep the cells (the grid's lattice).
+  void setMergeGrid(const GridGeometry& grid);
+  /// The grid set by setMergeGrid (unset until then: one beam per point).
+  std::optional<GridGeometry> mergeGrid() const;
 
  protected:
   ObservationSource(std::string name, const ObservationSourceConfig& config, ros::NodeHandle nh,
@@ -130,6 +137,8 @@ class ObservationSource {
   Health health_;
   ros::WallTime subscribed_since_;  ///< zero while unsubscribed; guarded by mutex_
   std::atomic<double> mark_max_z_{std::numeric_limits<double>::infinity()};
+  mutable std::mutex merge_grid_mutex_;
+  std::optional<GridGeometry> merge_grid_;  ///< guarded by merge_grid_mutex_
 };
 
 }  // namespace downstream_perception
