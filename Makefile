@@ -61,7 +61,7 @@ soak: build
 	@source tools/env.sh && source_workspace && python3 scripts/soak.py --out out \
 		--minutes $(SOAK_MINUTES) $(if $(SOAK_ONLY),--only $(SOAK_ONLY))
 
-lint:
+lint: deps
 	@tools/lint.sh
 
 clean:
