@@ -27,6 +27,32 @@ NO_INFORMATION, LETHAL, INSCRIBED, FREE = 255, 254, 253, 0
 OBSTACLE_TYPES = ("costmap_2d::ObstacleLayer", "costmap_2d::VoxelLayer")
 STATIC_TYPE = "costmap_2d::StaticLayer"
 INFLATION_TYPE = "costmap_2d::InflationLayer"
+OBSTACLE_TYPE, VOXEL_TYPE = OBSTACLE_TYPES
+# The keys costmap_2d copies from the costmap into a layer of each type (copyParentParameters);
+# loadOldParameters moves the same keys into the layers it generates.
+COPIED_KEYS: dict[str, tuple[str, ...]] = {
+    STATIC_TYPE: (
+        "map_topic",
+        "unknown_cost_value",
+        "lethal_cost_threshold",
+        "track_unknown_space",
+    ),
+    VOXEL_TYPE: (
+        "origin_z",
+        "z_resolution",
+        "z_voxels",
+        "mark_threshold",
+        "unknown_threshold",
+        "publish_voxel_map",
+    ),
+    OBSTACLE_TYPE: (
+        "max_obstacle_height",
+        "raytrace_range",
+        "obstacle_range",
+        "track_unknown_space",
+    ),
+    INFLATION_TYPE: ("cost_scaling_factor", "inflation_radius"),
+}
 # Our own spellings of the same layers count as the same kind.
 OUR_TYPES = {
     "downstream_perception/LogOddsObstacleLayer": "costmap_2d::ObstacleLayer",
@@ -63,6 +89,18 @@ def merge(tree: Params, ns: str, values: Params) -> None:
             merge(node[key], "", value)
         else:
             node[key] = copy.deepcopy(value)
+
+
+def load_pair_from(get: Any, ns: str = "/real_config") -> Params:
+    """load_pair() with its arguments read through `get` (rospy.get_param) from `ns`."""
+    return load_pair(
+        get(f"{ns}/common"),
+        get(f"{ns}/global"),
+        get(f"{ns}/local"),
+        get(f"{ns}/global_ns", ""),
+        get(f"{ns}/local_ns", ""),
+        get(f"{ns}/extra", ""),
+    )
 
 
 def load_pair(
@@ -108,6 +146,13 @@ def _move(src: Params, dst: Params, key: str, delete: bool = True) -> None:
             del src[key]
 
 
+def _move_pre_hydro(src: Params, dst: Params, keys: tuple[str, ...]) -> None:
+    """loadOldParameters' moves: every key leaves the costmap, except track_unknown_space, which
+    is copied (the costmap keeps its own)."""
+    for key in keys:
+        _move(src, dst, key, delete=key != "track_unknown_space")
+
+
 def plugin_list(costmap: Params) -> list[dict[str, str]]:
     """The layers costmap_2d loads, applying its parameter moves to `costmap` in place: the
     `plugins` list (after copyParentParameters), or the pre-Hydro list loadOldParameters
@@ -117,62 +162,25 @@ def plugin_list(costmap: Params) -> list[dict[str, str]]:
         for p in plugins:
             layer = costmap.setdefault(p["name"], {})
             kind = OUR_TYPES.get(p["type"], p["type"])
-            keys = {
-                STATIC_TYPE: (
-                    "map_topic",
-                    "unknown_cost_value",
-                    "lethal_cost_threshold",
-                    "track_unknown_space",
-                ),
-                "costmap_2d::VoxelLayer": (
-                    "origin_z",
-                    "z_resolution",
-                    "z_voxels",
-                    "mark_threshold",
-                    "unknown_threshold",
-                    "publish_voxel_map",
-                ),
-                "costmap_2d::ObstacleLayer": (
-                    "max_obstacle_height",
-                    "raytrace_range",
-                    "obstacle_range",
-                    "track_unknown_space",
-                ),
-                INFLATION_TYPE: ("cost_scaling_factor", "inflation_radius"),
-            }.get(kind, ())
+            keys = COPIED_KEYS.get(kind, ())
             for key in keys:
                 _move(costmap, layer, key, delete=False)
         return plugins
     plugins = []
     if costmap.get("static_map") is True:
         plugins.append({"name": "static_layer", "type": STATIC_TYPE})
-        layer = costmap.setdefault("static_layer", {})
-        for key in ("map_topic", "unknown_cost_value", "lethal_cost_threshold"):
-            _move(costmap, layer, key)
-        _move(costmap, layer, "track_unknown_space", delete=False)
+        _move_pre_hydro(costmap, costmap.setdefault("static_layer", {}), COPIED_KEYS[STATIC_TYPE])
     obstacles = costmap.setdefault("obstacle_layer", {})
     if costmap.get("map_type") == "voxel":
-        plugins.append({"name": "obstacle_layer", "type": "costmap_2d::VoxelLayer"})
-        for key in (
-            "origin_z",
-            "z_resolution",
-            "z_voxels",
-            "mark_threshold",
-            "unknown_threshold",
-            "publish_voxel_map",
-        ):
-            _move(costmap, obstacles, key)
+        plugins.append({"name": "obstacle_layer", "type": VOXEL_TYPE})
+        _move_pre_hydro(costmap, obstacles, COPIED_KEYS[VOXEL_TYPE])
     else:
-        plugins.append({"name": "obstacle_layer", "type": "costmap_2d::ObstacleLayer"})
-    for key in ("max_obstacle_height", "raytrace_range", "obstacle_range"):
-        _move(costmap, obstacles, key)
-    _move(costmap, obstacles, "track_unknown_space", delete=False)
+        plugins.append({"name": "obstacle_layer", "type": OBSTACLE_TYPE})
+    _move_pre_hydro(costmap, obstacles, COPIED_KEYS[OBSTACLE_TYPE])
     for source in str(costmap.get("observation_sources", "")).split():
         _move(costmap, obstacles, source)
     _move(costmap, obstacles, "observation_sources")
-    inflation = costmap.setdefault("inflation_layer", {})
-    _move(costmap, inflation, "cost_scaling_factor")
-    _move(costmap, inflation, "inflation_radius")
+    _move_pre_hydro(costmap, costmap.setdefault("inflation_layer", {}), COPIED_KEYS[INFLATION_TYPE])
     plugins.append({"name": "inflation_layer", "type": INFLATION_TYPE})
     costmap["plugins"] = plugins
     return plugins

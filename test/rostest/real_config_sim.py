@@ -17,7 +17,7 @@ import numpy as np
 import rospy
 import tf2_ros
 from geometry_msgs.msg import Point32, Pose2D
-from move_base_config import Scene, build_scene, load_pair
+from move_base_config import Scene, build_scene, load_pair_from
 from nav_msgs.msg import OccupancyGrid
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, PointField
 
@@ -29,15 +29,7 @@ RANGE_MAX_M = 30.0
 
 
 def load_scene() -> tuple[Scene, dict]:
-    p = rospy.get_param
-    tree = load_pair(
-        p("/real_config/common"),
-        p("/real_config/global"),
-        p("/real_config/local"),
-        p("/real_config/global_ns", ""),
-        p("/real_config/local_ns", ""),
-        p("/real_config/extra", ""),
-    )
+    tree = load_pair_from(rospy.get_param)
     return build_scene(tree), tree
 
 

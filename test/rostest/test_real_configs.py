@@ -36,7 +36,7 @@ from move_base_config import (
     build_scene,
     costmaps_of,
     inflation_of,
-    load_pair,
+    load_pair_from,
     translate,
 )
 
@@ -79,14 +79,7 @@ class RealConfigTest(unittest.TestCase):
         cls.robot = str(p("~robot", "robot"))
         cls.host = str(p("/real_config/host", "nodelet"))
         prefix = str(p("/real_config/prefix", ""))
-        tree = load_pair(
-            p("/real_config/common"),
-            p("/real_config/global"),
-            p("/real_config/local"),
-            p("/real_config/global_ns", ""),
-            p("/real_config/local_ns", ""),
-            p("/real_config/extra", ""),
-        )
+        tree = load_pair_from(rospy.get_param)
         cls.scene = build_scene(tree)
         cls.costmaps = list(costmaps_of(tree))
         cls.clients = {cm.ns: CostmapClient(f"{prefix}/{cm.ns}/costmap") for cm in cls.costmaps}
