@@ -4,6 +4,7 @@
 #pragma once
 
 #include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -24,6 +25,9 @@ std::string checkScan(const sensor_msgs::LaserScan& msg);
 /// x, y, z consecutive little-endian FLOAT32 fields, and point_step, row_step and the data size
 /// agreeing with width and height. *x_offset (if given) receives the x field's offset.
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg, std::size_t* x_offset = nullptr);
+
+/// A finite resolution > 0 and width x height (in 64 bits) equal to the data size.
+std::string checkOccupancyGrid(const nav_msgs::OccupancyGrid& msg);
 
 /// False with a reason for a depth image the TSDF cannot read: an encoding other than 32FC1 /
 /// 16UC1, a byte order other than the host's, or an inconsistent size.

@@ -8,6 +8,7 @@
 #include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/cost_values.h"
 #include "downstream_perception/layered_costmap.h"
+#include "downstream_perception/message_checks.h"
 #include "downstream_perception/param_reader.h"
 
 namespace downstream_perception {
@@ -40,9 +41,10 @@ void TsdfLayer::onSlice(const nav_msgs::OccupancyGridConstPtr& msg) {
   if (msg->header.frame_id != global_frame_) {
     why = "slice in '" + msg->header.frame_id + "', costmap in '" + global_frame_ +
           "' (run the TSDF with world_frame = the costmap's global_frame)";
-  } else if (!(info.resolution > 0.0f) || msg->data.size() != info.width * info.height) {
-    why = "inconsistent size";
-  } else if (std::abs(yaw_z) > 1e-6 || std::abs(std::abs(yaw_w) - 1.0) > 1e-6) {
+  } else {
+    why = checkOccupancyGrid(*msg);  // 64-bit width x height against the data
+  }
+  if (why.empty() && (std::abs(yaw_z) > 1e-6 || std::abs(std::abs(yaw_w) - 1.0) > 1e-6)) {
     why = "rotated grids are not supported";
   }
   if (!why.empty()) {

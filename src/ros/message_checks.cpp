@@ -23,6 +23,22 @@ bool hostIsBigEndian() {
 
 }  // namespace
 
+std::string checkOccupancyGrid(const nav_msgs::OccupancyGrid& msg) {
+  const auto& info = msg.info;
+  if (!(std::isfinite(info.resolution) && info.resolution > 0.0f)) {
+    return "resolution must be finite and > 0 m";
+  }
+  // 64 bits: width x height of two uint32 wraps around in 32 (65536 x 65536 is 0).
+  const std::uint64_t cells = std::uint64_t{info.width} * std::uint64_t{info.height};
+  if (cells != msg.data.size()) {
+    std::ostringstream why;
+    why << "data has " << msg.data.size() << " values, width x height = " << info.width << " x "
+        << info.height;
+    return why.str();
+  }
+  return "";
+}
+
 std::string checkScan(const sensor_msgs::LaserScan& msg) {
   const LaserScanView view{msg.ranges.data(),   msg.ranges.size(), msg.angle_min,
                            msg.angle_increment, msg.range_min,     msg.range_max};

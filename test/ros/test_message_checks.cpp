@@ -298,3 +298,24 @@ TEST(CheckPose, RefusesAGoalBeyondAnyMap) {
   p.pose.position.y = 1e300;
   EXPECT_NE(checkPose(p), "");
 }
+
+TEST(CheckOccupancyGrid, SizesAreComparedIn64Bits) {
+  nav_msgs::OccupancyGrid grid;
+  grid.info.resolution = 0.05f;
+  grid.info.width = 3;
+  grid.info.height = 2;
+  grid.data.assign(6, 0);
+  EXPECT_EQ(checkOccupancyGrid(grid), "");
+  grid.data.pop_back();
+  EXPECT_NE(checkOccupancyGrid(grid).find("data has 5 values"), std::string::npos);
+  // 65536 x 65536 is 0 in 32 bits: an empty grid claiming 2^32 cells must not pass.
+  grid.info.width = grid.info.height = 65536;
+  grid.data.clear();
+  EXPECT_NE(checkOccupancyGrid(grid), "");
+  grid.info.width = grid.info.height = 0;
+  EXPECT_EQ(checkOccupancyGrid(grid), "");  // an empty grid is consistent
+  for (const float r : {0.0f, -0.1f, std::numeric_limits<float>::quiet_NaN()}) {
+    grid.info.resolution = r;
+    EXPECT_NE(checkOccupancyGrid(grid), "") << r;
+  }
+}
