@@ -40,7 +40,7 @@ fuzz: build
 	@source tools/env.sh && cd "$$WS" && catkin_make -j2 fuzz_message_checks > "$$WS/fuzz_build.log" 2>&1 \
 		|| { tail -30 "$$WS/fuzz_build.log"; echo "fuzz: building fuzz_message_checks failed"; exit 1; }
 	@source tools/env.sh && source_workspace && \
-		python3 scripts/fuzz.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED) --out out/fuzz
+		python3 test/fuzz/fuzz.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED) --out out/fuzz
 
 fuzz-sanitize: deps
 	@tools/fuzz_sanitize.sh --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
@@ -49,16 +49,16 @@ demo: build
 	@source tools/env.sh && source_workspace && python3 scripts/demo.py --out out
 
 bench: build
-	@source tools/env.sh && source_workspace && python3 scripts/bench.py --out out
+	@source tools/env.sh && source_workspace && python3 bench/bench.py --out out
 
 # TSDF integration side by side with Open3D 0.19 (installed into .ws/open3d-venv for this only).
 bench-open3d: build
 	@tools/open3d_venv.sh
 	@source tools/env.sh && source_workspace && OMP_NUM_THREADS=1 \
-		"$$WS/open3d-venv/bin/python" scripts/bench_open3d.py
+		"$$WS/open3d-venv/bin/python" bench/bench_open3d.py
 
 soak: build
-	@source tools/env.sh && source_workspace && python3 scripts/soak.py --out out \
+	@source tools/env.sh && source_workspace && python3 bench/soak.py --out out \
 		--minutes $(SOAK_MINUTES) $(if $(SOAK_ONLY),--only $(SOAK_ONLY))
 
 lint: deps

@@ -15,8 +15,6 @@ from __future__ import annotations
 import argparse
 import os
 import shutil
-import signal
-import socket
 import subprocess
 import sys
 import time
@@ -25,14 +23,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from downstream_perception.ros.processes import free_port, stop_process
+
 if TYPE_CHECKING:
-    from downstream_perception.mesh_collector import MeshCollector
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
+    from downstream_perception.ros.mesh_collector import MeshCollector
 
 
 def free_display() -> int:
@@ -141,7 +135,7 @@ class Session:
             png = self.screenshot(name)
         finally:
             sub.unregister()
-            stop(proc)
+            stop_process(proc)
         return run_s, png
 
     def screenshot(self, name: str) -> Path | None:
@@ -164,16 +158,7 @@ class Session:
 
     def stop(self) -> None:
         for proc in reversed(self.procs):
-            stop(proc)
-
-
-def stop(proc: subprocess.Popen[bytes]) -> None:
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+            stop_process(proc)
 
 
 def grid_summary(msg: Any) -> dict[str, Any]:
@@ -371,8 +356,8 @@ def main() -> None:
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
 
-    from downstream_perception.costmap_client import CostmapClient
-    from downstream_perception.mesh_collector import MeshCollector
+    from downstream_perception.ros.costmap_client import CostmapClient
+    from downstream_perception.ros.mesh_collector import MeshCollector
 
     session = Session(out, args.timeout, rviz=not args.no_rviz)
     try:

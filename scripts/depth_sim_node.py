@@ -24,7 +24,7 @@ import tf2_ros
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Bool, Header
 
-from downstream_perception.ros_util import transform_from_matrix
+from downstream_perception.ros.util import transform_from_matrix
 from downstream_perception.sim.depth_camera import (
     CORRIDOR_PERIOD_M,
     DepthCamera,

@@ -16,7 +16,7 @@ import tf2_ros
 from std_msgs.msg import Bool
 
 from downstream_perception.msg import DetectedObjectArray
-from downstream_perception.ros_util import detection_array, transform_stamped
+from downstream_perception.ros.util import detection_array, transform_stamped
 from downstream_perception.sim import ObjectScene, SceneConfig
 
 

@@ -23,7 +23,7 @@ from std_msgs.msg import Bool
 
 from downstream_perception.msg import DetectedObjectArray
 from downstream_perception.planar import se2_matrix
-from downstream_perception.ros_util import detection_array, laser_scan, transform_stamped
+from downstream_perception.ros.util import detection_array, laser_scan, transform_stamped
 from downstream_perception.sim import WORLDS, Lidar, LidarConfig, aisle_drive, stand
 
 

@@ -13,4 +13,4 @@ set -u
 cd "$REPO"
 LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libubsan.so)" \
   ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-  python3 scripts/fuzz.py --skip msg --timeout 30 --out out/fuzz-sanitize "$@"
+  python3 test/fuzz/fuzz.py --skip msg --timeout 30 --out out/fuzz-sanitize "$@"

@@ -10,8 +10,8 @@ if [[ ! -x "$venv/bin/ruff" ]]; then
 fi
 [[ -x "$venv/bin/catkin_lint" ]] || "$venv/bin/pip" install -q "catkin_lint==1.6.25"
 cd "$REPO"
-"$venv/bin/ruff" check src scripts test tools
-"$venv/bin/ruff" format --check src scripts test tools
+"$venv/bin/ruff" check src scripts bench test tools
+"$venv/bin/ruff" format --check src scripts bench test tools
 clang-format --dry-run --Werror $(git ls-files '*.cpp' '*.h')
 # catkin_lint: errors fail (warnings and notices are listed). No rosdep database here, so it
 # cannot resolve system keys (it says so and goes on).

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <limits>
 
-#include "downstream_perception/config_errors.h"
-#include "downstream_perception/layered_costmap.h"
-#include "downstream_perception/param_reader.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/param_reader.h"
+#include "downstream_perception/ros/costmap/layered_costmap.h"
 
 namespace downstream_perception {
 

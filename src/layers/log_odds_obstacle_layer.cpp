@@ -7,11 +7,11 @@
 #include <cmath>
 #include <sstream>
 
-#include "downstream_perception/config_errors.h"
-#include "downstream_perception/core/footprint.h"
-#include "downstream_perception/layered_costmap.h"
-#include "downstream_perception/layers/laser_scan_source.h"
-#include "downstream_perception/layers/point_cloud_source.h"
+#include "downstream_perception/core/costmap/footprint.h"
+#include "downstream_perception/layers/observation/laser_scan_source.h"
+#include "downstream_perception/layers/observation/point_cloud_source.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/costmap/layered_costmap.h"
 
 namespace downstream_perception {
 

@@ -8,10 +8,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "downstream_perception/config_errors.h"
-#include "downstream_perception/core/cost_values.h"
-#include "downstream_perception/layered_costmap.h"
-#include "downstream_perception/param_reader.h"
+#include "downstream_perception/core/grid/cost_values.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/param_reader.h"
+#include "downstream_perception/ros/costmap/layered_costmap.h"
 
 namespace downstream_perception {
 

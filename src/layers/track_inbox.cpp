@@ -4,9 +4,9 @@
 
 #include <sstream>
 
-#include "downstream_perception/config_errors.h"
-#include "downstream_perception/tf_failure.h"
-#include "downstream_perception/track_transform.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/tf_failure.h"
+#include "downstream_perception/ros/common/track_transform.h"
 
 namespace downstream_perception {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/grid/grid_geometry.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"

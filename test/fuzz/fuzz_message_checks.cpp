@@ -8,7 +8,7 @@
 //   garbage <what>            the check accepted a message its consumers cannot read safely
 //   exception <what>          a consumer step threw (in a roscpp callback: the node dies)
 //   harness <what>            the case itself was malformed (a bug of the harness)
-// A crash or a hang is seen by the harness (scripts/fuzz.py) as the process dying or going quiet.
+// A crash or a hang is seen by the harness (test/fuzz/fuzz.py) as the process dying or going quiet.
 // No ROS master is needed: messages are only deserialized and checked.
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/serialization.h>
@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "downstream_perception/core/cloud_beams.h"
-#include "downstream_perception/core/scan_integrator.h"
-#include "downstream_perception/message_checks.h"
-#include "downstream_perception/tsdf_ros.h"
+#include "downstream_perception/core/costmap/cloud_beams.h"
+#include "downstream_perception/core/costmap/scan_integrator.h"
+#include "downstream_perception/ros/common/message_checks.h"
+#include "downstream_perception/ros/tsdf/tsdf_ros.h"
 
 namespace dp = downstream_perception;
 

@@ -1,4 +1,4 @@
-"""The side-by-side benchmark's bookkeeping (scripts/bench_open3d.py), with stand-in integrators:
+"""The side-by-side benchmark's bookkeeping (bench/bench_open3d.py), with stand-in integrators:
 Open3D itself is not installed for the tests."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "bench_open3d.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "bench" / "bench_open3d.py"
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ rospy = pytest.importorskip("rospy")
 from map_msgs.msg import OccupancyGridUpdate  # noqa: E402
 from nav_msgs.msg import OccupancyGrid  # noqa: E402
 
-from downstream_perception.costmap_client import CostmapClient  # noqa: E402
+from downstream_perception.ros.costmap_client import CostmapClient  # noqa: E402
 
 
 def full(width: int, height: int, value: int) -> OccupancyGrid:

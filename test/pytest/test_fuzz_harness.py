@@ -1,4 +1,4 @@
-"""The fuzz harness's bookkeeping (scripts/fuzz_harness.py), with stand-in targets: a crash
+"""The fuzz harness's bookkeeping (test/fuzz/fuzz_harness.py), with stand-in targets: a crash
 (os.abort), a hang (an endless loop), garbage (NaN where a number is due), clean and unclear
 errors, and a memory hog. Also: every binding entry point has a fuzz target, and every target's
 generator runs."""
@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+SCRIPTS = Path(__file__).resolve().parents[2] / "test" / "fuzz"
 sys.path.insert(0, str(SCRIPTS))
 
 import fuzz_harness as harness  # noqa: E402

@@ -10,11 +10,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "rostest"))
+sys.path.insert(0, str(ROOT / "rostest" / "real_configs"))
 
 import move_base_config as mbc  # noqa: E402
 
-CONFIGS = ROOT / "real_configs"
+CONFIGS = ROOT / "rostest" / "real_configs"
 PAIRS = {
     "turtlebot3_waffle": (
         "costmap_common_params_waffle.yaml",

@@ -20,7 +20,9 @@ PACKAGE = "downstream_perception"
 
 
 def _scripts() -> list[str]:
-    return sorted(p.name for p in (REPO / "scripts").iterdir() if os.access(p, os.X_OK))
+    # The nodes and the demo (scripts/) and the benchmark tools run by name (bench/).
+    folders = (REPO / "scripts", REPO / "bench")
+    return sorted(p.name for d in folders for p in d.iterdir() if os.access(p, os.X_OK))
 
 
 def _nodes() -> list[str]:
@@ -41,6 +43,7 @@ def _resolve(name: str) -> subprocess.CompletedProcess[str]:
 
 def test_the_lists_are_not_empty() -> None:
     assert "sim_node.py" in _scripts()
+    assert "costmap_compare.py" in _scripts()
     assert "costmap_node" in _nodes()
 
 

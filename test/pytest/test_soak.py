@@ -1,4 +1,4 @@
-"""The soak script's bookkeeping (scripts/soak.py): RSS growth, the samples it reports, the rate
+"""The soak script's bookkeeping (bench/soak.py): RSS growth, the samples it reports, the rate
 ramp's verdicts and the table. No ROS, no timing."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "soak.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "bench" / "soak.py"
 
 
 @pytest.fixture(scope="module")

@@ -17,8 +17,8 @@
 
 #include <memory>
 
-#include "downstream_perception/layer.h"
-#include "downstream_perception/layered_costmap.h"
+#include "downstream_perception/ros/costmap/layer.h"
+#include "downstream_perception/ros/costmap/layered_costmap.h"
 
 namespace downstream_perception {
 

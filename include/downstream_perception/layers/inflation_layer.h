@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "downstream_perception/InflationLayerConfig.h"
-#include "downstream_perception/config_errors.h"
-#include "downstream_perception/core/inflation.h"
-#include "downstream_perception/layer.h"
-#include "downstream_perception/running_stats.h"
+#include "downstream_perception/core/costmap/inflation.h"
+#include "downstream_perception/core/running_stats.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
 

@@ -19,13 +19,13 @@
 #include <vector>
 
 #include "downstream_perception/LogOddsObstacleLayerConfig.h"
-#include "downstream_perception/config_errors.h"
-#include "downstream_perception/core/log_odds_costs.h"
-#include "downstream_perception/core/log_odds_grid.h"
-#include "downstream_perception/layer.h"
-#include "downstream_perception/layers/observation_source.h"
+#include "downstream_perception/core/costmap/log_odds_costs.h"
+#include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/layers/observation/observation_source.h"
 #include "downstream_perception/layers/track_inbox.h"
-#include "downstream_perception/param_reader.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/param_reader.h"
+#include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
 

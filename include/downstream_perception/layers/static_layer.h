@@ -28,8 +28,8 @@
 #include <vector>
 
 #include "downstream_perception/StaticLayerConfig.h"
-#include "downstream_perception/core/static_map.h"
-#include "downstream_perception/layer.h"
+#include "downstream_perception/core/costmap/static_map.h"
+#include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
 

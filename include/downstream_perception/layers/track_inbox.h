@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "downstream_perception/TrackedObjectArray.h"
+#include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
-#include "downstream_perception/filtered_subscription.h"
-#include "downstream_perception/running_stats.h"
+#include "downstream_perception/ros/common/filtered_subscription.h"
 
 namespace downstream_perception {
 

@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "downstream_perception/TrackedObstacleLayerConfig.h"
-#include "downstream_perception/config_errors.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
-#include "downstream_perception/layer.h"
 #include "downstream_perception/layers/track_inbox.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "downstream_perception/layer.h"
+#include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
 

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "downstream_perception/core/ray_traversal.h"
+#include "downstream_perception/core/grid/ray_traversal.h"
 
 namespace downstream_perception {
 

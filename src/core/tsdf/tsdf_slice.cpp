@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "downstream_perception/core/inflation.h"
+#include "downstream_perception/core/costmap/inflation.h"
 
 namespace downstream_perception {
 

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "downstream_perception/core/footprint.h"
-#include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/costmap/footprint.h"
+#include "downstream_perception/core/grid/grid_geometry.h"
 
 namespace downstream_perception {
 

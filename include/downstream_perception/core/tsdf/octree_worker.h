@@ -15,9 +15,9 @@
 #include <thread>
 #include <vector>
 
+#include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/core/tsdf/occupancy_octree.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
-#include "downstream_perception/running_stats.h"
 
 namespace downstream_perception {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "downstream_perception/core/grid_geometry.h"
+#include "downstream_perception/core/grid/grid_geometry.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 
 namespace downstream_perception {

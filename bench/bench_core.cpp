@@ -1,0 +1,504 @@
+// Core micro-benchmarks; prints one JSON object per line. bench/bench.py runs this and writes
+// the report table. Scenario (as in the costmap_2d anchor harness): robot at the centre of a
+// square room (walls at +-room_half m) with two round pillars, 0.05 m cells, beams over 360 deg,
+// range_max 30 m, obstacle and raytrace range 30 m, a freshly noised scan every iteration.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <tuple>
+#include <vector>
+
+#include "downstream_perception/core/costmap/cloud_beams.h"
+#include "downstream_perception/core/costmap/inflation.h"
+#include "downstream_perception/core/costmap/log_odds_costs.h"
+#include "downstream_perception/core/costmap/scan_integrator.h"
+#include "downstream_perception/core/costmap/static_map.h"
+#include "downstream_perception/core/tracking/tracker.h"
+
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+
+double rayToCircle(double ox, double oy, double dx, double dy, double cx, double cy, double r) {
+  const double fx = ox - cx;
+  const double fy = oy - cy;
+  const double b = fx * dx + fy * dy;
+  const double c = fx * fx + fy * fy - r * r;
+  const double disc = b * b - c;
+  if (disc < 0.0) return INFINITY;
+  const double t = -b - std::sqrt(disc);
+  return t > 0.0 ? t : INFINITY;
+}
+
+std::vector<float> roomScan(int beams, double room_half, double noise, std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, noise);
+  std::vector<float> ranges(beams);
+  const double s = room_half / 4.475;  // obstacles scale with the room
+  for (int k = 0; k < beams; ++k) {
+    const double a = -M_PI + k * 2.0 * M_PI / beams;
+    const double dx = std::cos(a);
+    const double dy = std::sin(a);
+    double r = INFINITY;
+    if (dx != 0) r = std::min(r, room_half / std::abs(dx));
+    if (dy != 0) r = std::min(r, room_half / std::abs(dy));
+    r = std::min(r, rayToCircle(0, 0, dx, dy, -2.0 * s, 2.0 * s, 0.25 * s));
+    r = std::min(r, rayToCircle(0, 0, dx, dy, 1.0 * s, -2.5 * s, 0.4 * s));
+    r += n(rng);
+    ranges[k] = r > 30.0 ? INFINITY : static_cast<float>(r);
+  }
+  return ranges;
+}
+
+double medianOf(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double p90Of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() * 9 / 10];
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One obstacle-layer update as the costmap runs it: integrate the scan, then write the states of
+// the cells whose state changed into the master (what the layer reports as its bounds). Also
+// timed: the write over the whole window the scan touched (costmap_2d merges that window every
+// update) and the first scan into an empty (all-unknown) grid.
+void runIntegration(int size, double room_half, int beams, int iters) {
+  const GridGeometry geometry(size, size, 0.05, -size * 0.025, -size * 0.025);
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 30.0;
+  config.raytrace_max_range = 30.0;
+  ScanIntegrator integrator(config);
+  std::mt19937 rng(1);
+  std::vector<std::vector<float>> scans;
+  for (int i = 0; i < 16; ++i) scans.push_back(roomScan(beams, room_half, 0.01, rng));
+  const Pose2D pose{0.01, 0.02, 0.0};
+  const auto view = [&](int i) {
+    const auto& r = scans[i % scans.size()];
+    return LaserScanView{r.data(), r.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0};
+  };
+
+  std::vector<double> first;
+  for (int i = 0; i < 5; ++i) {
+    LogOddsGrid fresh(geometry);
+    const auto t0 = std::chrono::steady_clock::now();
+    integrator.integrate(fresh, view(i), pose);
+    first.push_back(msSince(t0));
+  }
+
+  LogOddsGrid grid(geometry);
+  Costmap master(geometry, cost::kNoInformation);
+  std::vector<double> integrate_ms, layer_ms, touched_write_ms;
+  std::size_t cells = 0;
+  std::size_t changed = 0;
+  for (int i = 0; i < iters + 20; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const IntegrationStats s = integrator.integrate(grid, view(i), pose);
+    const double t_integrate = msSince(t0);
+    writeStateCosts(grid, s.changed, false, cost::kNoInformation, &master);
+    const double t_layer = msSince(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    writeStateCosts(grid, s.touched, false, cost::kNoInformation, &master);
+    const double t_touched = msSince(t1);
+    if (i >= 20) {  // warm-up (the grid converging to steady state) excluded
+      integrate_ms.push_back(t_integrate);
+      layer_ms.push_back(t_layer);
+      touched_write_ms.push_back(t_touched);
+      cells += s.cells_cleared + s.cells_marked;
+      changed += s.cells_changed;
+    }
+  }
+  const double median = medianOf(integrate_ms);
+  const double cells_per_scan = static_cast<double>(cells) / iters;
+  std::printf(
+      "{\"bench\": \"scan_integration\", \"map\": %d, \"room_half_m\": %.3f, \"beams\": %d, "
+      "\"iters\": %d, \"median_ms\": %.4f, \"p90_ms\": %.4f, \"layer_update_ms\": %.4f, "
+      "\"touched_window_write_ms\": %.4f, \"first_scan_ms\": %.4f, \"cells_per_scan\": %.0f, "
+      "\"cells_changed_per_scan\": %.1f, \"mcells_per_s\": %.1f}\n",
+      size, room_half, beams, iters, median, p90Of(integrate_ms), medianOf(layer_ms),
+      medianOf(touched_write_ms), medianOf(first), cells_per_scan,
+      static_cast<double>(changed) / iters, cells_per_scan / (median * 1e-3) / 1e6);
+}
+
+// One whole costmap update as our costmap runs it on the anchor scenario (static map,
+// track_unknown_space false, footprint inscribed radius 0.25 m): integrate the scan, reset the
+// master window (cells whose obstacle state changed, grown by the inflation radius), write the
+// obstacle states, inflate. Reports the inflation step and the whole update.
+void runInflation(int size, double room_half, int beams, double radius, double csf, int iters,
+                  const char* bench = "inflation") {
+  const GridGeometry geometry(size, size, 0.05, -size * 0.025, -size * 0.025);
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 30.0;
+  config.raytrace_max_range = 30.0;
+  ScanIntegrator integrator(config);
+  InflationConfig ic;
+  ic.inflation_radius = radius;
+  ic.cost_scaling_factor = csf;
+  ic.inscribed_radius = 0.25;
+  Inflator inflator(ic, geometry.resolution());
+  std::mt19937 rng(1);
+  std::vector<std::vector<float>> scans;
+  for (int i = 0; i < 16; ++i) scans.push_back(roomScan(beams, room_half, 0.01, rng));
+  const Pose2D pose{0.01, 0.02, 0.0};
+  LogOddsGrid grid(geometry);
+  Costmap master(geometry, cost::kFreeSpace);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(size - 1, size - 1);
+  // Converge the log-odds grid first (a robot that has been looking at the room for 2 s).
+  for (int i = 0; i < 20; ++i) {
+    const auto& r = scans[i % scans.size()];
+    integrator.integrate(grid, {r.data(), r.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0}, pose);
+  }
+  writeStateCosts(grid, all, true, cost::kFreeSpace, &master);
+  auto t_first = std::chrono::steady_clock::now();
+  inflator.update(&master, all);
+  const double first_ms = msSince(t_first);
+
+  std::vector<double> inflate_ms, total_ms;
+  std::size_t lethal_changed = 0, recomputed = 0;
+  for (int i = 0; i < iters; ++i) {
+    const auto& r = scans[i % scans.size()];
+    const auto t0 = std::chrono::steady_clock::now();
+    const IntegrationStats s = integrator.integrate(
+        grid, {r.data(), r.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0}, pose);
+    CellBounds window = s.changed;
+    if (!window.empty()) {
+      window.min_x -= inflator.radiusCells();
+      window.min_y -= inflator.radiusCells();
+      window.max_x += inflator.radiusCells();
+      window.max_y += inflator.radiusCells();
+      master.resetWindow(window);
+      writeStateCosts(grid, window, true, cost::kFreeSpace, &master);
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    const InflationStats st = inflator.update(&master, window);
+    inflate_ms.push_back(msSince(t1));
+    total_ms.push_back(msSince(t0));
+    lethal_changed += st.lethal_changed;
+    recomputed += st.cells_recomputed;
+  }
+  std::size_t lethal = 0, inscribed = 0, nonzero = 0;
+  for (const std::uint8_t c : master.cells()) {
+    lethal += c == cost::kLethalObstacle;
+    inscribed += c == cost::kInscribedInflatedObstacle;
+    nonzero += c != cost::kFreeSpace;
+  }
+  std::printf(
+      "{\"bench\": \"%s\", \"map\": %d, \"room_half_m\": %.3f, \"beams\": %d, "
+      "\"radius_m\": %.2f, \"cost_scaling_factor\": %.1f, \"iters\": %d, "
+      "\"inflation_median_ms\": %.4f, \"inflation_p90_ms\": %.4f, \"update_median_ms\": %.4f, "
+      "\"first_full_inflation_ms\": %.4f, \"lethal_changed_per_update\": %.1f, "
+      "\"cells_recomputed_per_update\": %.0f, \"lethal\": %zu, \"inscribed\": %zu, "
+      "\"nonzero\": %zu}\n",
+      bench, size, room_half, beams, radius, csf, iters, medianOf(inflate_ms), p90Of(inflate_ms),
+      medianOf(total_ms), first_ms, static_cast<double>(lethal_changed) / iters,
+      static_cast<double>(recomputed) / iters, lethal, inscribed, nonzero);
+}
+
+// Rolling window: a 10 m x 10 m robot-centred map (200^2) while the robot drives 1 cell per
+// update through a long corridor of pillars. Per update: shift master, obstacle grid and
+// inflation cache by one cell, integrate a scan, redraw the whole window (as LayeredCostmap does
+// after a shift), inflate. Compared with re-inflating the whole window from scratch.
+void runRolling(int iters) {
+  const int size = 200;
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 5.0;
+  config.raytrace_max_range = 5.0;
+  ScanIntegrator integrator(config);
+  InflationConfig ic;
+  ic.inflation_radius = 0.55;
+  ic.inscribed_radius = 0.25;
+  const int beams = 720;
+  // Corridor walls at y = +-1.5 m with pillars every 2 m; ranges from the robot at (x, 0).
+  const auto scan = [&](double x) {
+    std::vector<float> r(beams);
+    for (int k = 0; k < beams; ++k) {
+      const double a = -M_PI + k * 2.0 * M_PI / beams;
+      const double dx = std::cos(a), dy = std::sin(a);
+      double range = dy != 0 ? 1.5 / std::abs(dy) : INFINITY;
+      for (double px = std::floor(x / 2.0) * 2.0 - 6.0; px < x + 8.0; px += 2.0) {
+        range = std::min(range, rayToCircle(x, 0.0, dx, dy, px, 0.9, 0.15));
+      }
+      r[k] = range > 30.0 ? INFINITY : static_cast<float>(range);
+    }
+    return r;
+  };
+  Inflator incremental(ic, 0.05);
+  Inflator scratch(ic, 0.05);
+  GridGeometry geometry(size, size, 0.05, -5.0, -5.0);
+  LogOddsGrid grid(geometry);
+  Costmap master(geometry, cost::kNoInformation);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(size - 1, size - 1);
+  std::vector<double> update_ms, shift_inflate_ms, full_inflate_ms;
+  for (int i = 0; i < iters + 10; ++i) {
+    const double x = 0.05 * i;
+    const auto ranges = scan(x);
+    const auto t0 = std::chrono::steady_clock::now();
+    if (i > 0) {
+      master.shift(1, 0);
+      grid.shift(1, 0);
+      incremental.shift(1, 0);
+    }
+    integrator.integrate(
+        grid, {ranges.data(), ranges.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0}, {x, 0.0, 0.0});
+    master.reset();
+    writeStateCosts(grid, all, false, cost::kFreeSpace, &master);
+    Costmap copy = master;
+    const auto t1 = std::chrono::steady_clock::now();
+    incremental.update(&master, all);
+    const double t_inflate = msSince(t1);
+    const double t_update = msSince(t0);
+    const auto t2 = std::chrono::steady_clock::now();
+    scratch.reset();
+    scratch.update(&copy, all);
+    const double t_full = msSince(t2);
+    if (i >= 10) {
+      update_ms.push_back(t_update);
+      shift_inflate_ms.push_back(t_inflate);
+      full_inflate_ms.push_back(t_full);
+    }
+  }
+  std::printf(
+      "{\"bench\": \"rolling\", \"map\": %d, \"beams\": %d, \"radius_m\": 0.55, \"iters\": %d, "
+      "\"update_median_ms\": %.4f, \"inflation_median_ms\": %.4f, "
+      "\"full_reinflation_median_ms\": %.4f}\n",
+      size, beams, iters, medianOf(update_ms), medianOf(shift_inflate_ms),
+      medianOf(full_inflate_ms));
+}
+
+// A 640 x 480 depth camera (307,200 points) 0.4 m above the floor looking at a wall 4 m away:
+// the lower part of the image sees the floor (outside the height band), the rest the wall.
+void runCloud(int iters) {
+  const int w = 640, h = 480;
+  std::vector<float> xyz;
+  xyz.reserve(static_cast<std::size_t>(w) * h * 3);
+  const double fx = 525.0;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      // Camera frame x forward, y left, z up (already rotated to the body convention).
+      const double dy = -(u - w / 2.0) / fx;
+      const double dz = -(v - h / 2.0) / fx;
+      double t = 4.0;                            // wall at x = 4 m
+      if (dz < 0.0) t = std::min(t, 0.4 / -dz);  // floor 0.4 m below the camera
+      xyz.push_back(static_cast<float>(t));
+      xyz.push_back(static_cast<float>(t * dy));
+      xyz.push_back(static_cast<float>(t * dz));
+    }
+  }
+  const GridGeometry geometry(200, 200, 0.05, -5.0, -5.0);
+  LogOddsGrid grid(geometry);
+  ScanIntegratorConfig config;
+  config.obstacle_max_range = 5.0;
+  config.raytrace_max_range = 5.0;
+  ScanIntegrator integrator(config);
+  CloudBeamsConfig cloud;
+  cloud.min_obstacle_height = 0.05;
+  cloud.max_obstacle_height = 1.8;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation().z() = 0.4;
+  // Median (beam making ms, integration ms, beams) of `iters` clouds with one config.
+  const auto run = [&](const CloudBeamsConfig& c) {
+    std::vector<double> beams_ms, integrate_ms;
+    std::vector<BeamUpdate> beams;
+    for (int i = 0; i < iters; ++i) {
+      beams.clear();
+      IntegrationStats decisions;
+      const auto t0 = std::chrono::steady_clock::now();
+      beamsFromCloud(integrator, c, reinterpret_cast<const unsigned char*>(xyz.data()),
+                     static_cast<std::size_t>(w) * h, 3 * sizeof(float), pose, &beams, &decisions);
+      beams_ms.push_back(msSince(t0));
+      const auto t1 = std::chrono::steady_clock::now();
+      integrator.integrate(grid, beams, decisions);
+      integrate_ms.push_back(msSince(t1));
+    }
+    return std::make_tuple(medianOf(beams_ms), medianOf(integrate_ms), beams.size());
+  };
+  CloudBeamsConfig merged = cloud;
+  merged.merge_grid = geometry;
+  const auto [merged_beams_ms, merged_integrate_ms, merged_beams] = run(merged);
+  const auto [beams_ms, integrate_ms, beams_in_band] = run(cloud);
+  std::printf(
+      "{\"bench\": \"cloud\", \"points\": %d, \"beams_in_band\": %zu, \"iters\": %d, "
+      "\"beams_median_ms\": %.4f, \"integrate_median_ms\": %.4f, \"merged_beams\": %zu, "
+      "\"merged_beams_median_ms\": %.4f, \"merged_integrate_median_ms\": %.4f}\n",
+      w * h, beams_in_band, iters, beams_ms, integrate_ms, merged_beams, merged_beams_ms,
+      merged_integrate_ms);
+}
+
+// One decay pass over a 1000^2 grid whose every cell holds evidence.
+void runDecay(int iters) {
+  const GridGeometry geometry(1000, 1000, 0.05, 0.0, 0.0);
+  LogOddsGrid grid(geometry);
+  CellBounds all;
+  all.expand(0, 0);
+  all.expand(999, 999);
+  std::vector<double> ms;
+  for (int i = 0; i < iters; ++i) {
+    if (i % 20 == 0) {
+      for (std::size_t c = 0; c < geometry.cellCount(); ++c) grid.setLogOdds(c, c % 2 ? 8.0 : -8.0);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    grid.decay(0.95, all);
+    ms.push_back(msSince(t0));
+  }
+  std::printf("{\"bench\": \"decay\", \"map\": 1000, \"iters\": %d, \"median_ms\": %.4f}\n", iters,
+              medianOf(ms));
+}
+
+// Tracker throughput: N objects moving at constant velocity (bouncing off the walls of a square
+// sized for ~1 object per 25 m^2), 10 Hz, 90 % detection probability, 0.1 m noise, 5 % clutter.
+void runTracker(int n, int frames) {
+  std::mt19937 rng(11);
+  const double half = std::sqrt(25.0 * n) / 2.0;
+  std::uniform_real_distribution<double> pos(-half, half), vel(-1.5, 1.5), unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::vector<std::array<double, 4>> objects(n);
+  std::vector<int> truth(n);
+  int next_truth = 0;
+  for (int i = 0; i < n; ++i) {
+    objects[i] = {pos(rng), pos(rng), vel(rng), vel(rng)};
+    truth[i] = next_truth++;
+  }
+  Tracker tracker;
+  std::vector<double> us;
+  std::size_t switches = 0;
+  std::vector<Detection> detections;
+  for (int f = 0; f < frames + 20; ++f) {
+    detections.clear();
+    for (int i = 0; i < n; ++i) {
+      auto& o = objects[i];
+      o[0] += 0.1 * o[2];
+      o[1] += 0.1 * o[3];
+      if (std::abs(o[0]) > half || std::abs(o[1]) > half) {
+        // Left the area: a new object enters elsewhere (a new truth id, not a bounce).
+        o = {pos(rng), pos(rng), vel(rng), vel(rng)};
+        truth[i] = next_truth++;
+      }
+      if (unit(rng) < 0.9) {
+        Detection d;
+        d.x = o[0] + noise(rng);
+        d.y = o[1] + noise(rng);
+        d.score = 0.6 + 0.4 * unit(rng);
+        d.truth_id = truth[i];
+        detections.push_back(d);
+      }
+    }
+    for (int c = 0; c < std::max(1, n / 20); ++c) {
+      Detection d;
+      d.x = pos(rng);
+      d.y = pos(rng);
+      d.score = 0.5 * unit(rng) + 0.3;
+      detections.push_back(d);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const TrackerStats s = tracker.step(0.1 * f, detections);
+    if (f >= 20) {
+      us.push_back(msSince(t0) * 1000.0);
+      switches += s.id_switches;
+    }
+  }
+  std::printf(
+      "{\"bench\": \"tracker\", \"objects\": %d, \"frames\": %d, \"median_us\": %.2f, "
+      "\"p90_us\": %.2f, \"id_switches\": %zu}\n",
+      n, frames, medianOf(us), p90Of(us), switches);
+}
+
+// The static layer: a map_server-sized map (4000 x 4000 cells, 200 m at 0.05 m: walls every 5 m,
+// an unknown border) mapped to costs, a 100 x 100 OccupancyGridUpdate applied, and the copies into
+// the master (whole map after a map, the window after an update).
+void runStaticMap(int iters) {
+  const int n = 4000, w = 100;
+  std::vector<std::int8_t> data(static_cast<std::size_t>(n) * n, 0);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      std::int8_t& v = data[static_cast<std::size_t>(y) * n + x];
+      if (x < 20 || y < 20 || x >= n - 20 || y >= n - 20) {
+        v = -1;
+      } else if (x % 100 == 0 || y % 100 == 0) {
+        v = 100;
+      }
+    }
+  }
+  std::vector<std::int8_t> update(static_cast<std::size_t>(w) * w, 100);
+  StaticMapInfo info;
+  info.width = n, info.height = n, info.resolution = 0.05, info.origin_x = -100.0;
+  info.origin_y = -100.0, info.data_size = data.size();
+  StaticMap map;
+  Costmap master(GridGeometry(n, n, 0.05, -100.0, -100.0), cost::kNoInformation);
+  std::vector<double> set_ms, update_us, copy_all_ms, copy_window_us;
+  const int map_reps = std::max(5, iters / 20);
+  for (int k = 0; k < map_reps; ++k) {
+    auto t0 = std::chrono::steady_clock::now();
+    if (!map.setMap(info, data.data()).empty()) std::abort();
+    set_ms.push_back(msSince(t0));
+    t0 = std::chrono::steady_clock::now();
+    copyStaticOverwrite(map.costs(), &master, 0, 0, n, n);
+    copy_all_ms.push_back(msSince(t0));
+  }
+  for (int k = 0; k < iters; ++k) {
+    const int x = (k * 137) % (n - w), y = (k * 311) % (n - w);
+    auto t0 = std::chrono::steady_clock::now();
+    if (!map.applyUpdate(x, y, w, w, update.data(), update.size()).empty()) std::abort();
+    update_us.push_back(msSince(t0) * 1000.0);
+    t0 = std::chrono::steady_clock::now();
+    copyStaticOverwrite(map.costs(), &master, x, y, x + w, y + w);
+    copy_window_us.push_back(msSince(t0) * 1000.0);
+  }
+  std::printf(
+      "{\"bench\": \"static_map\", \"cells\": %d, \"update_cells\": %d, "
+      "\"set_map_median_ms\": %.2f, \"copy_map_median_ms\": %.2f, "
+      "\"update_median_us\": %.2f, \"update_p90_us\": %.2f, \"copy_update_median_us\": %.2f, "
+      "\"lethal_cells\": %zu}\n",
+      n * n, w * w, medianOf(set_ms), medianOf(copy_all_ms), medianOf(update_us), p90Of(update_us),
+      medianOf(copy_window_us), map.counts().lethal);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int iters = 200;
+  if (argc > 1) iters = std::max(10, std::atoi(argv[1]));
+  if (argc > 2 && std::strcmp(argv[2], "static") == 0) {  // the static-map rows only
+    runStaticMap(iters);
+    return 0;
+  }
+  const int only_size = argc > 2 ? std::atoi(argv[2]) : 0;  // 0 = all map sizes
+  for (int size : {200, 1000}) {
+    if (only_size != 0 && size != only_size) continue;
+    const double room_half = size == 200 ? 4.475 : 22.475;
+    for (int beams : {360, 1080, 3600}) runIntegration(size, room_half, beams, iters);
+  }
+  // The costmap_2d anchor scenarios (radius m, cost_scaling_factor).
+  for (int size : {200, 1000}) {
+    if (only_size != 0 && size != only_size) continue;
+    const double room_half = size == 200 ? 4.475 : 22.475;
+    for (double radius : {0.55, 1.0}) runInflation(size, room_half, 360, radius, 10.0, iters);
+    if (size == 1000) runInflation(size, room_half, 3600, 2.5, 3.0, iters);
+  }
+  if (only_size != 0) return 0;
+  // Update time against inflation radius and map size (the plot in bench.md).
+  for (int size : {200, 500, 1000}) {
+    const double room_half = size * 0.025 - 0.525;
+    for (double radius : {0.25, 0.55, 1.0, 1.5, 2.5}) {
+      runInflation(size, room_half, 360, radius, 3.0, iters, "inflation_sweep");
+    }
+  }
+  runRolling(iters);
+  runCloud(std::max(10, iters / 10));
+  runDecay(std::max(10, iters / 4));
+  for (int n : {10, 50, 200}) runTracker(n, std::max(100, iters * 2));
+  runStaticMap(iters);
+  return 0;
+}

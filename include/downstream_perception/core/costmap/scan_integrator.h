@@ -1,0 +1,166 @@
+// Integration of range measurements into a LogOddsGrid.
+//
+// A measurement becomes a BeamUpdate (where to clear, whether and where to mark). A batch of
+// beams from one scan is integrated in two passes, so that every cell gets at most one update per
+// scan and a hit always wins over a pass-through from another beam of the same scan (as in
+// OctoMap's insertPointCloud): beams that graze a wall at a shallow angle must not erode the cells
+// that other beams of the same sweep just saw as occupied.
+//   pass 1: each marking beam adds l_hit to its hit cell (once per cell)
+//   pass 2: each clearing beam walks its cells (Amanatides-Woo) and adds l_miss to every cell not
+//           yet updated in this scan; the cell containing a hit is never cleared by its own beam.
+//
+// Range semantics for a sensor_msgs/LaserScan (REP-117 and LaserScan.msg):
+//   NaN                      invalid: ignored
+//   -Inf                     "too close to measure": ignored (no free space can be inferred)
+//   +Inf                     no return within range_max: if inf_is_valid, clears up to
+//                            raytrace_max_range and marks nothing; else ignored
+//   r < range_min            invalid per LaserScan.msg: ignored
+//   r > range_max            invalid per LaserScan.msg: ignored
+//   r == range_max           a return, unless range_max_is_no_return (drivers that report
+//                            range_max for "nothing seen"): then treated as +Inf
+//   otherwise                a return at r: marks the hit cell if r <= obstacle_max_range (and
+//                            r >= obstacle_min_range); clears from raytrace_min_range to
+//                            min(r, raytrace_max_range). A beam truncated by raytrace_max_range
+//                            clears through its last cell, because that cell is a pass-through.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/core/grid/se2.h"
+
+namespace downstream_perception {
+
+struct BeamUpdate {
+  double start_x = 0.0;  ///< where clearing starts (world, m)
+  double start_y = 0.0;
+  double end_x = 0.0;  ///< where clearing ends (world, m); the hit point when mark is true
+  double end_y = 0.0;
+  bool clear = false;           ///< walk the cells from start to end adding l_miss
+  bool clear_end_cell = false;  ///< include the cell containing the end point in the clearing
+  bool mark = false;            ///< add l_hit to the cell containing (hit_x, hit_y)
+  double hit_x = 0.0;
+  double hit_y = 0.0;
+};
+
+struct IntegrationStats {
+  std::size_t beams = 0;            ///< beams offered
+  std::size_t beams_marked = 0;     ///< beams whose hit cell got (or shared) a hit update
+  std::size_t beams_no_return = 0;  ///< +Inf (or range_max when treated so) beams that cleared
+  std::size_t beams_invalid = 0;    ///< NaN, -Inf, outside [range_min, range_max]
+  std::size_t beams_beyond_obstacle_range = 0;  ///< returns too far (or near) to mark
+  std::size_t points_outside_height = 0;        ///< cloud points outside [min, max]_obstacle_height
+  std::size_t points_merged = 0;  ///< cloud points sharing a merge cell with an earlier one
+  /// Cells walked by clearing rays, per beam (a cell two beams cross counts twice, as in the
+  /// lesson's "a 10 m beam clears ~200 cells"). Each cell still receives at most one miss
+  /// update per scan, and none if it was hit in the same scan.
+  std::size_t cells_cleared = 0;
+  std::size_t cells_marked = 0;   ///< cells that received a hit update
+  std::size_t cells_changed = 0;  ///< cells whose state (free/occupied/unknown) changed
+  CellBounds touched;             ///< window of every updated cell
+  CellBounds changed;             ///< window of the cells whose state changed
+
+  /// Cells cleared per cell marked (the lesson's phantom-wall diagnostic; healthy >> 1).
+  double clearMarkRatio() const {
+    return cells_marked == 0 ? static_cast<double>(cells_cleared)
+                             : static_cast<double>(cells_cleared) / cells_marked;
+  }
+  void accumulate(const IntegrationStats& o);
+};
+
+/// Integrates one batch of beams (one scan) as described above. `scratch` (optional) is reused
+/// between calls to avoid an allocation per scan.
+IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
+                                std::vector<std::uint32_t>* scratch = nullptr);
+
+struct ScanIntegratorConfig {
+  /// Largest accepted obstacle / raytrace range (m): 10 km, beyond any range sensor. A larger
+  /// value is a typo, and ranges of ~1e15 m put beam ends where a double cannot place them.
+  static constexpr double kMaxRangeM = 1e4;
+
+  bool marking = true;
+  bool clearing = true;
+  double obstacle_min_range = 0.0;      ///< m: returns nearer than this do not mark
+  double obstacle_max_range = 2.5;      ///< m: returns farther than this do not mark
+  double raytrace_min_range = 0.0;      ///< m: clearing starts this far from the sensor
+  double raytrace_max_range = 3.0;      ///< m: clearing stops this far from the sensor
+  bool inf_is_valid = true;             ///< +Inf means "no return": clear, do not mark
+  bool range_max_is_no_return = false;  ///< treat r == range_max as +Inf
+
+  /// Empty if 0 <= obstacle_min_range <= obstacle_max_range <= kMaxRangeM and the same for the
+  /// raytrace ranges (all finite), else the reason.
+  std::string validate() const;
+};
+
+/// A LaserScan without ROS: ranges[i] is at angle angle_min + i * angle_increment (sensor frame).
+struct LaserScanView {
+  const float* ranges = nullptr;
+  std::size_t count = 0;
+  double angle_min = 0.0;
+  double angle_increment = 0.0;
+  double range_min = 0.0;
+  double range_max = 0.0;
+
+  /// Empty if the header fields make sense (finite angles, increment != 0, 0 <= range_min <
+  /// range_max, count > 0), else the reason.
+  std::string validate() const;
+};
+
+class ScanIntegrator {
+ public:
+  explicit ScanIntegrator(const ScanIntegratorConfig& config = {});
+  const ScanIntegratorConfig& config() const { return config_; }
+
+  /// REP-117 decisions for each beam (see the file comment), with the sensor at `sensor_pose`
+  /// in the grid's frame. Appends to *beams; counts ignored beams into *stats.
+  void beamsFromScan(const LaserScanView& scan, const Pose2D& sensor_pose,
+                     std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
+  /// Same for a scan taken while the sensor moved: beam k is cast from the pose interpolated
+  /// (linear in x, y; shortest arc in yaw) between the pose at the first beam and the pose at the
+  /// last beam. This is the per-beam time correction of a spinning lidar on a moving robot.
+  void beamsFromMovingScan(const LaserScanView& scan, const Pose2D& first_beam_pose,
+                           const Pose2D& last_beam_pose, std::vector<BeamUpdate>* beams,
+                           IntegrationStats* stats) const;
+  /// Same for one measurement with its own sensor origin and direction (point clouds,
+  /// per-beam de-skewed scans): range may be NaN / +-Inf with the scan semantics.
+  void beamFromRange(double origin_x, double origin_y, double direction_rad, double range,
+                     double range_min, double range_max, std::vector<BeamUpdate>* beams,
+                     IntegrationStats* stats) const;
+  /// Same with the direction given as its unit vector (cos, sin).
+  void beamFromDirection(double origin_x, double origin_y, double cos_dir, double sin_dir,
+                         double range, double range_min, double range_max,
+                         std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
+  /// Same for a measured point (a cloud point, in the grid's frame): a return at its horizontal
+  /// distance from the origin whose hit, and the end of its clearing ray, is the point itself, so
+  /// the cell it marks is the cell containing it. A point at zero horizontal range (straight above
+  /// or below the sensor) is a return at range 0: it marks the sensor's own cell (if range_min
+  /// and obstacle_min_range are 0) and clears nothing, as costmap_2d marks it.
+  void beamToPoint(double origin_x, double origin_y, double point_x, double point_y,
+                   double range_min, double range_max, std::vector<BeamUpdate>* beams,
+                   IntegrationStats* stats) const;
+
+  /// integrateBeams over beams made by the beamsFrom* calls; the beam counts of `decisions`
+  /// (filled by those calls) are carried into the result.
+  IntegrationStats integrate(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
+                             const IntegrationStats& decisions);
+  /// beamsFromScan + integrateBeams. Throws std::invalid_argument if scan.validate() fails.
+  /// Not thread-safe (reuses a scratch buffer): one integrator per thread.
+  IntegrationStats integrate(LogOddsGrid& grid, const LaserScanView& scan,
+                             const Pose2D& sensor_pose);
+
+ private:
+  /// The REP-117 decisions of beamFromDirection; `point` (or nullptr) is the measured point at
+  /// `range` along (c, s), used as the hit and the clearing end instead of recomputing it.
+  void makeBeam(double origin_x, double origin_y, double c, double s, double range,
+                double range_min, double range_max, const double* point,
+                std::vector<BeamUpdate>* beams, IntegrationStats* stats) const;
+
+  ScanIntegratorConfig config_;
+  std::vector<BeamUpdate> scratch_;
+  std::vector<std::uint32_t> flagged_scratch_;
+};
+
+}  // namespace downstream_perception

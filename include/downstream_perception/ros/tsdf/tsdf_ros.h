@@ -1,0 +1,141 @@
+// ROS host of the TSDF: depth images (+ CameraInfo) and/or point clouds in, each fused at its own
+// stamp in a fixed world frame (a tf2 MessageFilter holds a message until its transform exists);
+// the mesh out as per-block rviz markers and a height-band slice (OccupancyGrid, for the
+// TsdfLayer and rviz) at ~mesh_rate_hz; services to save the mesh and clear
+// the map; diagnostics; the settings that keep the voxel lattice live through
+// dynamic_reconfigure. The nodelet and the node are thin shells around it.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <Eigen/Geometry>
+#include <boost/thread/recursive_mutex.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/SaveMap.h"
+#include "downstream_perception/TsdfNodeletConfig.h"
+#include "downstream_perception/core/running_stats.h"
+#include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/octree_worker.h"
+#include "downstream_perception/core/tsdf/tsdf_health.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/save_service.h"
+#include "downstream_perception/ros/tsdf/tsdf_mesh_markers.h"
+
+namespace downstream_perception {
+
+class TsdfRos {
+ public:
+  TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~TsdfRos();
+
+ private:
+  void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg);
+  void onDepthRaw(const sensor_msgs::ImageConstPtr& msg);  ///< checks, then waits for tf
+  void onDepth(const sensor_msgs::ImageConstPtr& msg);     ///< tf available: integrates
+  void onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg);
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
+  /// The pinhole model for an image from the latest CameraInfo of its frame, or why not.
+  bool cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why);
+  /// A MessageFilter into world_frame_ calling on_ready, and reject() with the reason on a drop.
+  template <class M>
+  void attachTfFilter(FilteredSubscription<M>* filter,
+                      void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&),
+                      const std::string& what, int queue);
+  bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
+  void publishMesh(const ros::TimerEvent& event);
+  /// malloc_trim every kTrimPeriodS (on the mesh timer): freed memory goes back to the OS.
+  void returnFreeMemory();
+  static constexpr int kTrimPeriodS = 5;
+  std::chrono::steady_clock::time_point last_trim_{};
+  /// Centres of the OctoMap's occupied leaves as a PointCloud2 (x, y, z) for rviz.
+  sensor_msgs::PointCloud2Ptr occupiedCloud(const std_msgs::Header& header);
+  bool saveOctomap(SaveMap::Request& request, SaveMap::Response& response);
+  bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);
+  bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void reconfigure(TsdfNodeletConfig& config, std::uint32_t level);
+  void reject(const std::string& reason, const std::string& detail);
+  void account(const TsdfIntegrationStats& stats, double elapsed_ms);
+
+  ros::NodeHandle nh_;
+  ros::NodeHandle pnh_;
+  std::string world_frame_;
+  std::mutex mutex_;  ///< guards the map, the mesher and the counters
+  std::unique_ptr<TsdfMap> map_;
+  DepthIntegrator integrator_;  ///< keeps the per-pixel buffers between frames
+  TsdfMesher mesher_;
+  TsdfMeshMarkers markers_;
+  std::map<std::string, sensor_msgs::CameraInfo> camera_infos_;  ///< latest per frame id
+
+  std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Subscriber camera_info_subscriber_;
+  ros::Subscriber depth_subscriber_;
+  FilteredSubscription<sensor_msgs::Image> depth_filter_;
+  ros::Subscriber cloud_subscriber_;
+  FilteredSubscription<sensor_msgs::PointCloud2> cloud_filter_;
+  ros::Publisher mesh_publisher_;
+  ros::Publisher slice_publisher_;
+  ros::Publisher slice_distance_publisher_;  ///< not advertised when slice_distance_max_m is 0
+  ros::Publisher octomap_publisher_;
+  ros::ServiceServer save_octomap_service_;
+  /// Inserts into the OctoMap on its own thread; null when ~octomap_resolution_m is 0.
+  std::unique_ptr<OctreeWorker> octree_;
+  std::atomic<std::size_t> octree_occupied_{0};  ///< set by the publishing timer
+  std::size_t octree_max_memory_bytes_ = 0;      ///< ~octomap_max_memory_mb
+  TsdfSliceConfig slice_;
+  bool slice_changed_ = false;         ///< the band moved: re-slice at the next mesh tick
+  double slice_distance_max_m_ = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
+  TsdfSliceStats slice_stats_;
+  ros::ServiceServer save_service_;
+  OutputDirectory output_directory_{
+      defaultOutputDirectory()};  ///< ~output_dir: services write here
+  ros::ServiceServer clear_service_;
+  ros::Timer mesh_timer_;
+  diagnostic_updater::Updater diagnostics_;
+
+  // Diagnostics.
+  std::size_t frames_integrated_ = 0;
+  std::map<std::string, std::size_t> rejected_;
+  TsdfIntegrationStats last_;
+  std::size_t pixels_invalid_ = 0;
+  std::size_t blocks_refused_ = 0;
+  std::size_t blocks_evicted_ = 0;
+  std::size_t pixels_no_return_ignored_ = 0;  ///< +Inf pixels carving refused to use (total)
+  RunningStats integrate_ms_;
+  RunningStats mesh_ms_;
+  std::size_t mesh_triangles_ = 0;
+  double health_period_s_ = 10.0;
+  ros::Time last_health_;
+  TsdfHealth health_;
+  ConfigErrorLog config_errors_;
+
+  using ReconfigureServer = dynamic_reconfigure::Server<TsdfNodeletConfig>;
+  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  boost::recursive_mutex reconfigure_mutex_;
+  bool reconfigure_started_ = false;
+};
+
+}  // namespace downstream_perception

@@ -1,0 +1,561 @@
+#include "downstream_perception/ros/tsdf/tsdf_ros.h"
+
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <malloc.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "downstream_perception/core/tsdf/tsdf_health.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/message_checks.h"
+#include "downstream_perception/ros/common/save_service.h"
+#include "downstream_perception/ros/common/tf_failure.h"
+#include "downstream_perception/ros/tsdf/tsdf_params.h"
+#include "downstream_perception/ros/tsdf/tsdf_slice_messages.h"
+
+namespace downstream_perception {
+
+namespace {
+
+Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  return T;
+}
+
+}  // namespace
+
+template <class M>
+void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
+                             void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&),
+                             const std::string& what, int queue) {
+  filter->attach(
+      nh_, *tf_buffer_, world_frame_, queue, boost::bind(on_ready, this, boost::placeholders::_1),
+      [this, what](const boost::shared_ptr<const M>& m,
+                   tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+        std::ostringstream detail;
+        detail << what << " in '" << m->header.frame_id << "' at stamp " << m->header.stamp;
+        reject(tfFailureReason(reason), detail.str());
+      });
+}
+
+TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
+  config_errors_.setPrefix("tsdf");
+  pnh_.param("world_frame", world_frame_, std::string("odom"));
+  output_directory_ = readOutputDirectory(pnh_, &config_errors_);
+  double mesh_rate_hz = 1.0;
+  pnh_.param("mesh_rate_hz", mesh_rate_hz, mesh_rate_hz);
+  if (!(std::isfinite(mesh_rate_hz) && mesh_rate_hz > 0.0 && mesh_rate_hz <= 100.0)) {
+    config_errors_.add("parameter ~mesh_rate_hz = " + toText(mesh_rate_hz) +
+                       " must be in (0, 100] Hz; using 1");
+    mesh_rate_hz = 1.0;
+  }
+  pnh_.param("health_period_s", health_period_s_, health_period_s_);
+  if (!(std::isfinite(health_period_s_) && health_period_s_ >= 0.0)) {
+    config_errors_.add("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
+    health_period_s_ = 10.0;
+  }
+  pnh_.param("slice_min_z_m", slice_.min_z_m, slice_.min_z_m);
+  pnh_.param("slice_max_z_m", slice_.max_z_m, slice_.max_z_m);
+  const std::string slice_why = slice_.validate();
+  if (!slice_why.empty()) {
+    config_errors_.add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
+    slice_ = TsdfSliceConfig{};
+  }
+  pnh_.param("slice_distance_max_m", slice_distance_max_m_, slice_distance_max_m_);
+  if (!(std::isfinite(slice_distance_max_m_) && slice_distance_max_m_ >= 0.0 &&
+        slice_distance_max_m_ <= 100.0)) {
+    config_errors_.add("parameter ~slice_distance_max_m = " + toText(slice_distance_max_m_) +
+                       " must be in [0, 100] m (0 = off); using 2");
+    slice_distance_max_m_ = 2.0;
+  }
+  int tf_queue_size = 10;
+  pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
+  if (tf_queue_size < 1 || tf_queue_size > 1000) {
+    config_errors_.add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
+    tf_queue_size = 10;
+  }
+  map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
+  OctreeConfig octree;
+  pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
+  pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
+  octree.max_range_m = map_->config().max_depth_m;
+  octree.max_distance_m = map_->config().max_block_distance_m;  // the TSDF's bound
+  double octree_max_memory_mb = static_cast<double>(octree.max_memory_bytes) / (1 << 20);
+  pnh_.param("octomap_max_memory_mb", octree_max_memory_mb, octree_max_memory_mb);
+  if (!(std::isfinite(octree_max_memory_mb) && octree_max_memory_mb >= 1.0 &&
+        octree_max_memory_mb <= 1e6)) {
+    config_errors_.add("parameter ~octomap_max_memory_mb = " + toText(octree_max_memory_mb) +
+                       " must be in [1, 1e6] MiB; using 256");
+    octree_max_memory_mb = 256.0;
+  }
+  octree.max_memory_bytes = static_cast<std::size_t>(octree_max_memory_mb * (1 << 20));
+  int octree_queue = 2;
+  pnh_.param("octomap_queue_size", octree_queue, octree_queue);
+  if (octree_queue < 1 || octree_queue > 100) {
+    config_errors_.add("parameter ~octomap_queue_size must be in [1, 100]; using 2");
+    octree_queue = 2;
+  }
+  if (octree.resolution_m > 0.0) {  // 0 turns the OctoMap off
+    const std::string why = octree.validate();
+    if (!why.empty()) {
+      config_errors_.add("OctoMap parameters invalid (" + why + "); using the defaults");
+      octree = OctreeConfig{};
+      octree.max_distance_m = map_->config().max_block_distance_m;
+    }
+    octree_max_memory_bytes_ = octree.max_memory_bytes;
+    octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octree),
+                                             static_cast<std::size_t>(octree_queue));
+  }
+
+  mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
+  slice_publisher_ = pnh_.advertise<nav_msgs::OccupancyGrid>("slice", 1, true);
+  if (slice_distance_max_m_ > 0.0) {
+    slice_distance_publisher_ = pnh_.advertise<sensor_msgs::PointCloud2>("slice_distance", 1, true);
+  }
+  save_service_ = pnh_.advertiseService("save_mesh", &TsdfRos::saveMesh, this);
+  if (octree_) {
+    octomap_publisher_ = pnh_.advertise<sensor_msgs::PointCloud2>("octomap_occupied", 1, true);
+    save_octomap_service_ = pnh_.advertiseService("save_octomap", &TsdfRos::saveOctomap, this);
+  }
+  clear_service_ = pnh_.advertiseService("clear", &TsdfRos::clear, this);
+  diagnostics_.setHardwareID("tsdf " + world_frame_);
+  diagnostics_.add("tsdf", this, &TsdfRos::diagnose);
+
+  tf_buffer_ = std::make_shared<tf2_ros::Buffer>(ros::Duration(30.0));
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
+  camera_info_subscriber_ = nh_.subscribe("depth/camera_info", 5, &TsdfRos::onCameraInfo, this);
+  // Raw subscribers check each message first (a wrong encoding is reported at once instead of
+  // waiting for tf) and pass it to a tf2 MessageFilter, which holds it until the transform to
+  // the world frame at its stamp exists.
+  attachTfFilter(&depth_filter_, &TsdfRos::onDepth, "depth image", tf_queue_size);
+  depth_subscriber_ = nh_.subscribe("depth/image", 5, &TsdfRos::onDepthRaw, this);
+  attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", tf_queue_size);
+  cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
+  mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
+  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
+  reconfigure_server_->setCallback(
+      boost::bind(&TsdfRos::reconfigure, this, boost::placeholders::_1, boost::placeholders::_2));
+  const TsdfConfig& c = map_->config();
+  ROS_INFO(
+      "tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s; files saved "
+      "into %s",
+      c.voxel_size_m, c.truncation(), world_frame_.c_str(),
+      ros::names::resolve(nh_.getNamespace(), "depth/image").c_str(),
+      ros::names::resolve(nh_.getNamespace(), "points").c_str(),
+      output_directory_.directory().c_str());
+}
+
+TsdfRos::~TsdfRos() {
+  reconfigure_server_.reset();
+  mesh_timer_.stop();
+  depth_subscriber_.shutdown();
+  cloud_subscriber_.shutdown();
+  depth_filter_.unsubscribe();
+  cloud_filter_.unsubscribe();
+}
+
+void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
+  if (!reconfigure_started_) {
+    // The first call carries the parameter server's values, already read (and reported if
+    // invalid) by the constructor: nothing to apply.
+    reconfigure_started_ = true;
+    return;
+  }
+  TsdfConfig next;
+  TsdfSliceConfig slice;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    next = map_->config();
+    slice = slice_;
+  }
+  next.max_weight = cfg.max_weight;
+  next.behind_surface_dropoff = cfg.behind_surface_dropoff;
+  next.edge_guard_rad = cfg.edge_guard_rad;
+  next.interpolate_depth = cfg.interpolate_depth;
+  next.carve_free_space = cfg.carve_free_space;
+  next.no_return_carve_min_valid_fraction = cfg.no_return_carve_min_valid_fraction;
+  next.min_depth_m = cfg.min_depth_m;
+  next.max_depth_m = cfg.max_depth_m;
+  next.min_weight = cfg.min_weight;
+  next.max_block_distance_m = cfg.max_block_distance_m;
+  std::string why = setNamedTsdfSettings(cfg.weighting, cfg.max_blocks, &next);
+  TsdfSliceConfig next_slice = slice;
+  next_slice.min_z_m = cfg.slice_min_z_m;
+  next_slice.max_z_m = cfg.slice_max_z_m;
+  const std::string slice_why = next_slice.validate();
+  TsdfConfig now;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (why.empty()) why = map_->setConfig(next);
+    if (slice_why.empty()) {
+      slice_changed_ = slice_changed_ || next_slice.min_z_m != slice_.min_z_m ||
+                       next_slice.max_z_m != slice_.max_z_m;
+      slice_ = next_slice;
+    }
+    now = map_->config();
+    slice = slice_;
+  }
+  if (!why.empty())
+    config_errors_.add("live TSDF parameters refused (" + why + "); keeping the previous");
+  if (octree_) octree_->setMaxDistance(now.max_block_distance_m);  // valid: the map took it
+  if (!slice_why.empty()) {
+    config_errors_.add("live slice band refused (" + slice_why + "); keeping [" +
+                       toText(slice.min_z_m) + ", " + toText(slice.max_z_m) + "] m");
+  }
+  ROS_INFO("tsdf: live settings: max weight %.1f, depth [%.2f, %.2f] m, slice [%.2f, %.2f] m",
+           now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m);
+}
+
+void TsdfRos::reject(const std::string& reason, const std::string& detail) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++rejected_[reason];
+  }
+  ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s: %s", reason.c_str(), detail.c_str());
+}
+
+bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::string* why) {
+  try {
+    *T =
+        toEigen(tf_buffer_->lookupTransform(world_frame_, header.frame_id, header.stamp).transform);
+    return true;
+  } catch (const tf2::TransformException& e) {
+    *why = e.what();
+    return false;
+  }
+}
+
+void TsdfRos::onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  camera_infos_[msg->header.frame_id] = *msg;
+}
+
+void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
+  if (stats.refused != nullptr) {  // counted as rejected, like the node's own checks
+    ++rejected_[std::string("integrator: ") + stats.refused];
+    ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s", stats.refused);
+    return;
+  }
+  ++frames_integrated_;
+  last_ = stats;
+  pixels_invalid_ += stats.pixels_invalid;
+  blocks_refused_ += stats.blocks_refused;
+  blocks_evicted_ += stats.blocks_evicted;
+  pixels_no_return_ignored_ += stats.pixels_no_return_ignored;
+  integrate_ms_.add(elapsed_ms);
+}
+
+bool TsdfRos::cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = camera_infos_.find(image.header.frame_id);
+  if (it == camera_infos_.end()) {
+    *why = "no CameraInfo yet for frame '" + image.header.frame_id + "'";
+    return false;
+  }
+  if (it->second.width != image.width || it->second.height != image.height) {
+    *why = "image " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+           " but CameraInfo " + std::to_string(it->second.width) + "x" +
+           std::to_string(it->second.height);
+    return false;
+  }
+  const auto& K = it->second.K;
+  *camera = PinholeCamera{
+      K[0], K[4], K[2], K[5], static_cast<int>(image.width), static_cast<int>(image.height)};
+  *why = camera->validate();
+  return why->empty();
+}
+
+void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
+  if (msg->header.stamp.isZero()) {
+    reject("bad message: zero stamp", "depth images must carry their measurement time");
+    return;
+  }
+  std::string why;
+  PinholeCamera camera;
+  if (!checkDepthImage(*msg, &why)) {  // converted once, after tf, in onDepth()
+    reject("bad depth image", why);
+  } else if (!cameraFor(*msg, &camera, &why)) {
+    reject("camera_info missing or inconsistent", why);
+  } else {
+    depth_filter_.add(msg);
+  }
+}
+
+void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
+  std::vector<float> metres;
+  std::string why;
+  PinholeCamera camera;
+  Eigen::Isometry3d T_world_camera;
+  // Checked on arrival already; the CameraInfo may have changed while waiting for tf.
+  if (!depthImageToMetres(*msg, &metres, &why) || !cameraFor(*msg, &camera, &why)) {
+    reject("camera_info missing or inconsistent", why);
+    return;
+  }
+  if (!lookup(msg->header, &T_world_camera, &why)) {
+    reject("tf: lookup at stamp failed", why);
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto t0 = std::chrono::steady_clock::now();
+    const TsdfIntegrationStats stats =
+        integrator_.integrate(map_.get(), metres.data(), camera, T_world_camera);
+    account(
+        stats,
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  // The same observation, as occupancy, inserted on the OctoMap's own thread.
+  if (octree_) octree_->submitDepth(std::move(metres), camera, T_world_camera);
+  diagnostics_.update();
+}
+
+void TsdfRos::onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  if (msg->header.stamp.isZero()) {
+    reject("bad message: zero stamp", "point clouds must carry their measurement time");
+    return;
+  }
+  const std::string why = checkCloudLayout(*msg);  // the layout every cloud consumer checks
+  if (!why.empty()) {
+    reject("bad point cloud", why);
+    return;
+  }
+  cloud_filter_.add(msg);
+}
+
+void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  Eigen::Isometry3d T_world_sensor;
+  std::string why;
+  if (!lookup(msg->header, &T_world_sensor, &why)) {
+    reject("tf: lookup at stamp failed", why);
+    return;
+  }
+  std::size_t x_offset = 0;
+  if (!checkCloudLayout(*msg, &x_offset).empty()) return;  // checked on arrival (onCloudRaw)
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<std::size_t>(msg->width) * msg->height);
+  forEachCloudPoint(*msg, x_offset, [&](float x, float y, float z) {
+    points.push_back(T_world_sensor * Eigen::Vector3d(x, y, z));  // NaN stays NaN: counted
+  });
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto t0 = std::chrono::steady_clock::now();
+    const TsdfIntegrationStats stats =
+        integratePoints(map_.get(), points, T_world_sensor.translation());
+    account(
+        stats,
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  if (octree_) octree_->submitPoints(std::move(points), T_world_sensor.translation());
+  diagnostics_.update();
+}
+
+void TsdfRos::publishMesh(const ros::TimerEvent&) {
+  visualization_msgs::MarkerArray markers;
+  nav_msgs::OccupancyGridPtr slice;
+  std::vector<SliceCell> slice_cells;
+  GridGeometry slice_geometry;
+  double slice_z = 0.0;
+  sensor_msgs::PointCloud2Ptr occupied;
+  std_msgs::Header header;
+  header.frame_id = world_frame_;
+  header.stamp = ros::Time::now();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto t0 = std::chrono::steady_clock::now();
+    mesher_.update(*map_);  // evicted blocks are reported by markers_.changed() too
+    mesh_ms_.add(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    markers = markers_.changed(mesher_, header);
+    if (!mesher_.lastUpdated().empty() || !markers.markers.empty() || slice_changed_) {
+      slice_geometry = sliceGeometry(*map_);
+      if (slice_geometry.sizeX() > 0) {
+        slice_cells = sliceTsdf(*map_, slice_geometry, slice_, &slice_stats_);
+      }
+      slice_z = slice_.min_z_m;
+      slice = sliceGridMessage(slice_cells, slice_geometry, slice_z, header);
+      slice_changed_ = false;
+    }
+    mesh_triangles_ = 0;
+    for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
+    // The health check walks the whole map (tens of ms): every health_period_s at most.
+    const ros::Time now = ros::Time::now();
+    if (health_period_s_ > 0.0 && !mesher_.lastUpdated().empty() &&
+        (last_health_.isZero() || (now - last_health_).toSec() >= health_period_s_)) {
+      health_ = tsdfHealth(*map_);
+      last_health_ = now;
+    }
+  }
+  // Outside mutex_: reading the OctoMap waits for an insertion under way, which must not hold
+  // up the TSDF.
+  if (octree_ && octree_->takeChanged()) occupied = occupiedCloud(header);
+  if (!markers.markers.empty()) mesh_publisher_.publish(markers);
+  if (slice) slice_publisher_.publish(slice);
+  // The clearance map only while someone listens (latched: a late subscriber gets the next).
+  if (slice && slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
+    slice_distance_publisher_.publish(
+        sliceDistanceCloud(sliceDistance(slice_cells, slice_geometry, slice_distance_max_m_),
+                           slice_geometry, slice_z, header));
+  }
+  if (occupied) octomap_publisher_.publish(occupied);
+  returnFreeMemory();
+  diagnostics_.update();
+}
+
+void TsdfRos::returnFreeMemory() {
+  // Depth frames, cloud points and OctoMap rays are allocated and freed in bursts on several
+  // threads; glibc keeps what its per-thread arenas freed, so the process's RSS wanders a few
+  // MB above what the maps hold (the soak measured the swing in the arenas alone). Handing the
+  // free pages back every few seconds keeps RSS to what the bounded maps use.
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_trim_ < std::chrono::seconds(kTrimPeriodS)) return;
+  last_trim_ = now;
+  malloc_trim(0);
+}
+
+sensor_msgs::PointCloud2Ptr TsdfRos::occupiedCloud(const std_msgs::Header& header) {
+  const std::vector<Eigen::Vector3d> centres =
+      octree_->read([](const OccupancyOctree& tree) { return tree.occupiedCenters(); });
+  sensor_msgs::PointCloud2Ptr cloud(new sensor_msgs::PointCloud2);
+  cloud->header = header;
+  sensor_msgs::PointCloud2Modifier modifier(*cloud);
+  modifier.setPointCloud2FieldsByString(1, "xyz");
+  modifier.resize(centres.size());
+  sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+  for (const Eigen::Vector3d& c : centres) {
+    *x = static_cast<float>(c.x());
+    *y = static_cast<float>(c.y());
+    *z = static_cast<float>(c.z());
+    ++x, ++y, ++z;
+  }
+  octree_occupied_ = centres.size();
+  return cloud;
+}
+
+bool TsdfRos::saveOctomap(SaveMap::Request& request, SaveMap::Response& response) {
+  return serveSave("tsdf", "save_octomap", output_directory_, ".bt", request, response,
+                   [&](std::ostream& out, std::string* what) {
+                     return octree_->read([&](const OccupancyOctree& tree) {
+                       *what = std::to_string(tree.leafCount()) + " leaves";
+                       return tree.writeBinary(out);
+                     });
+                   });
+}
+
+bool TsdfRos::saveMesh(SaveMap::Request& request, SaveMap::Response& response) {
+  return serveSave("tsdf", "save_mesh", output_directory_, ".ply", request, response,
+                   [&](std::ostream& out, std::string* what) {
+                     // A mesher of its own: the published one's lastUpdated() feeds the
+                     // markers and must not be consumed here.
+                     TsdfMesher mesher;
+                     {
+                       std::lock_guard<std::mutex> lock(mutex_);
+                       mesher.update(*map_);
+                     }
+                     const TriangleMesh mesh = mesher.combined();
+                     mesh.writePly(out);
+                     *what = std::to_string(mesh.vertices.size()) + " vertices, " +
+                             std::to_string(mesh.triangleCount()) + " triangles";
+                     return static_cast<bool>(out);
+                   });
+}
+
+bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  visualization_msgs::MarkerArray markers;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    map_->clear();
+    mesher_.clear();
+    std_msgs::Header header;
+    header.frame_id = world_frame_;
+    header.stamp = ros::Time::now();
+    markers = markers_.clearAll(header);
+  }
+  if (octree_) octree_->clear();
+  mesh_publisher_.publish(markers);
+  ROS_INFO("tsdf: map cleared");
+  return true;
+}
+
+void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t rejected = 0;
+  for (const auto& [reason, count] : rejected_) {
+    status.add("rejected (" + reason + ")", count);
+    rejected += count;
+  }
+  status.add("frames integrated", frames_integrated_);
+  status.add("frames rejected", rejected);
+  status.add("integration time mean (ms)", integrate_ms_.mean());
+  status.add("integration time max (ms)", integrate_ms_.max);
+  status.add("last frame: valid pixels or points", last_.pixels_valid);
+  status.add("last frame: voxels updated", last_.voxels_updated);
+  status.add("invalid pixels or points (total)", pixels_invalid_);
+  status.add("blocks", map_->blockCount());
+  status.add("memory (MB)", static_cast<double>(map_->memoryBytes()) / 1e6);
+  status.add("blocks refused at max_blocks (total)", blocks_refused_);
+  status.add("blocks evicted by distance (total)", blocks_evicted_);
+  status.add("blocks evicted to a lowered max_blocks (total)", map_->blocksEvictedToCap());
+  status.add("no-return pixels not carved: too few valid depths in their frame (total)",
+             pixels_no_return_ignored_);
+  status.add("mesh triangles", mesh_triangles_);
+  status.add("slice: occupied cells", slice_stats_.cells_occupied);
+  status.add("slice band (m)", toText(slice_.min_z_m) + " .. " + toText(slice_.max_z_m));
+  status.add("slice distance cap (m)",
+             slice_distance_max_m_ > 0.0 ? toText(slice_distance_max_m_) : std::string("off"));
+  status.add("max_weight", map_->config().max_weight);
+  status.add("free-space carving", map_->config().carve_free_space ? "on" : "off");
+  status.add("depth range (m)",
+             toText(map_->config().min_depth_m) + " .. " + toText(map_->config().max_depth_m));
+  if (octree_) {
+    const OctreeWorker::Stats octree = octree_->stats();
+    status.add("octomap: observations inserted", octree.inserted);
+    status.add("octomap: observations dropped (queue full: insertion slower than the sensor)",
+               octree.dropped);
+    status.add("octomap: leaves", octree.leaves);
+    status.add("octomap: nodes", octree.nodes);
+    status.add("octomap: occupied leaves", octree_occupied_.load());
+    status.add("octomap: memory (MB)", static_cast<double>(octree.memory_bytes) / 1e6);
+    status.add("octomap: memory cap (MB)", static_cast<double>(octree_max_memory_bytes_) / 1e6);
+    status.add("octomap: nodes evicted by distance (total)", octree.nodes_evicted_by_distance);
+    status.add("octomap: nodes evicted at the memory cap (total)", octree.nodes_evicted_at_cap);
+    status.add("octomap: maintenance time mean (ms)", octree.maintenance_ms.mean());
+    status.add("octomap: maintenance time max (ms)", octree.maintenance_ms.max);
+    status.add("octomap: insertion time mean (ms)", octree.insert_ms.mean());
+    status.add("octomap: insertion time max (ms)", octree.insert_ms.max);
+  }
+  status.add("slice: free cells", slice_stats_.cells_free);
+  status.add("mesh update time mean (ms)", mesh_ms_.mean());
+  if (!last_health_.isZero()) {
+    status.add("health: zero crossings", health_.crossings);
+    status.add("health: mean |grad(D mu)| (1 = true distances; oblique views read 1/cos)",
+               health_.mean_gradient_ratio);
+    status.add("health: double crossings within mu (drift or thin objects)",
+               health_.double_crossings);
+  }
+  const std::size_t waiting = addTfWaits(status, "depth images: ", depth_filter_.waitingForTf()) +
+                              addTfWaits(status, "point clouds: ", cloud_filter_.waitingForTf());
+  if (config_errors_.report(status)) return;  // ERROR, with the first problem
+  if (waiting > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::to_string(waiting) + " frame(s) waiting for tf (see 'waiting for tf')");
+  } else if (frames_integrated_ == 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame integrated yet");
+  } else if (blocks_refused_ > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "max_blocks reached: parts of the scene are not mapped");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "fusing");
+  }
+}
+
+}  // namespace downstream_perception
