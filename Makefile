@@ -12,7 +12,7 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d soak lint clean
+.PHONY: help deps build install-check test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d soak lint clean
 
 FUZZ_CASES ?= 20000
 FUZZ_SEED ?= 17
@@ -20,7 +20,7 @@ SOAK_MINUTES ?= 10
 SOAK_ONLY ?=
 
 help:
-	@echo "make demo | make test | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make soak | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make install-check | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make soak | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -31,6 +31,10 @@ build: deps
 
 test: build
 	@tools/run_tests.sh
+
+# An install space (.ws/install) and a smoke test run from it alone (tools/install_smoke.py).
+install-check: build
+	@tools/install_check.sh
 
 test-sanitize: deps
 	@tools/test_sanitize.sh

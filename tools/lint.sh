@@ -12,6 +12,7 @@ fi
 cd "$REPO"
 "$venv/bin/ruff" check src scripts bench test tools
 "$venv/bin/ruff" format --check src scripts bench test tools
+python3 tools/check_core_boundary.py sources
 clang-format --dry-run --Werror $(git ls-files '*.cpp' '*.h')
 # catkin_lint: errors fail (warnings and notices are listed). No rosdep database here, so it
 # cannot resolve system keys (it says so and goes on).
