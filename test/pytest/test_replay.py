@@ -1,0 +1,210 @@
+"""The replay tool (downstream_perception.replay) on bags recorded here from the lidar simulator
+with the rosbag API: the costmap nodelet run on the bag's time makes the world's walls lethal, the
+map it writes loads back into the StaticLayer's mapping to the same cells, and bags that cannot
+be replayed fail before anything starts with a reason and exit status 2."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+rospy = pytest.importorskip("rospy")
+rosbag = pytest.importorskip("rosbag")
+
+import downstream_perception as dp  # noqa: E402
+from downstream_perception import replay  # noqa: E402
+from downstream_perception.planar import se2_matrix  # noqa: E402
+from downstream_perception.ros.util import laser_scan, transform_stamped  # noqa: E402
+from downstream_perception.sim import Lidar, LidarConfig, aisle_drive, warehouse_aisle  # noqa: E402
+
+CONFIG = Path(__file__).resolve().parent / "replay_costmap.yaml"
+START_S = 100.0
+
+
+def record_bag(
+    path: Path,
+    duration_s: float = 8.0,
+    scan_topic: str = "/scan",
+    with_tf: bool = True,
+    tf_jump_at_s: float | None = None,
+) -> Path:
+    """The robot drives the warehouse aisle at 1 m/s: scans at 10 Hz (frame laser), tf
+    map <- odom <- base_link at 50 Hz and a static base_link <- laser."""
+    world, drive = warehouse_aisle(), aisle_drive(1.0)
+    lidar = Lidar(LidarConfig(num_beams=360, range_max=30.0, noise_std_m=0.01, seed=3))
+    map_odom = se2_matrix(0.5, -0.2, 0.05)
+    odom_map = np.linalg.inv(map_odom)
+    from tf2_msgs.msg import TFMessage
+
+    with rosbag.Bag(str(path), "w") as bag:
+        start = rospy.Time.from_sec(START_S)
+        if with_tf:
+            static = transform_stamped("base_link", "laser", start, x=0.0, z=0.2)
+            bag.write("/tf_static", TFMessage([static]), start)
+        for k in range(int(duration_s * 50) + 1):
+            t = k / 50.0
+            stamp_s = START_S + t
+            if tf_jump_at_s is not None and t >= tf_jump_at_s:
+                stamp_s -= 30.0  # the clock went back: a looped recording
+            stamp = rospy.Time.from_sec(stamp_s)
+            x, y, yaw = drive.pose(t)
+            odom_base = odom_map @ se2_matrix(x, y, yaw)
+            if with_tf:
+                tfs = [
+                    transform_stamped("map", "odom", stamp, x=0.5, y=-0.2, yaw=0.05),
+                    transform_stamped(
+                        "odom",
+                        "base_link",
+                        stamp,
+                        x=odom_base[0, 2],
+                        y=odom_base[1, 2],
+                        yaw=math.atan2(odom_base[1, 0], odom_base[0, 0]),
+                    ),
+                ]
+                bag.write("/tf", TFMessage(tfs), rospy.Time.from_sec(START_S + t))
+            if k % 5 == 0:
+                c = lidar.config
+                ranges = lidar.scan(world, (x, y, yaw), t)
+                msg = laser_scan(
+                    stamp, "laser", ranges, c.angle_min, c.angle_increment, c.range_min, c.range_max
+                )
+                msg.scan_time = 0.1
+                bag.write(scan_topic, msg, rospy.Time.from_sec(START_S + t))
+    return path
+
+
+def _classes(values: np.ndarray) -> np.ndarray:
+    """0 free, 1 lethal, 2 unknown, per map_server's thresholds."""
+    out = np.full(values.shape, 2, dtype=np.int8)
+    out[(values >= 0) & (values <= replay.FREE_MAX)] = 0
+    out[values >= replay.OCCUPIED_MIN] = 1
+    return out
+
+
+@pytest.fixture(scope="module")
+def replayed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    if shutil.which("roscore") is None:
+        pytest.skip("roscore is not installed")
+    out = tmp_path_factory.mktemp("replay")
+    bag = record_bag(out / "aisle.bag")
+    status = replay.main(
+        [str(bag), "--config", str(CONFIG), "--out", str(out / "result"), "--rate", "4", "--quiet"]
+    )
+    assert status == 0
+    return out / "result"
+
+
+def test_the_walls_the_world_has_are_lethal(replayed: Path) -> None:
+    meta = yaml.safe_load((replayed / "costmap.yaml").read_text())
+    pgm = replay.read_pgm(replayed / meta["image"])
+    values = np.flipud(
+        np.where(pgm == replay.PGM_OCCUPIED, 100, np.where(pgm == replay.PGM_FREE, 0, -1))
+    )
+    height, width = values.shape
+    res, (ox, oy, _) = meta["resolution"], meta["origin"]
+    truth = warehouse_aisle().occupied_cells(ox, oy, res, width, height)
+    near_truth = truth.copy()  # within one cell of a wall, pillar or the pallet
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            near_truth |= np.roll(np.roll(truth, dy, axis=0), dx, axis=1)
+    lethal = values == 100
+    assert lethal.sum() > 200
+    assert (lethal & ~near_truth).sum() <= 0.01 * lethal.sum()  # no ghosts
+    # The shelves beside the driven stretch (x 1..7 m, seen from 1.5 m) are lethal.
+    cols = slice(int((1.0 - ox) / res), int((7.0 - ox) / res))
+    for wall_y in (1.5, -1.5):
+        rows = slice(int((wall_y - oy) / res) - 1, int((wall_y - oy) / res) + 2)
+        seen = lethal[rows, cols].any(axis=0)
+        assert seen.mean() > 0.9, f"shelf at y = {wall_y}: {seen.mean():.2f} of its columns lethal"
+    # Inside the aisle along the path: free.
+    row = int((0.0 - oy) / res)
+    assert (values[row, cols] == 0).mean() > 0.95
+
+
+def test_the_map_loads_back_into_the_static_layer(replayed: Path) -> None:
+    meta = yaml.safe_load((replayed / "costmap.yaml").read_text())
+    assert meta["image"] == "costmap.pgm" and meta["negate"] == 0
+    pgm = replay.read_pgm(replayed / meta["image"])
+    # map_server: p = (255 - v) / 255; occupied above occupied_thresh, free below free_thresh.
+    p = (255.0 - pgm) / 255.0
+    loaded = np.where(p > meta["occupied_thresh"], 100, np.where(p < meta["free_thresh"], 0, -1))
+    loaded = np.flipud(loaded).astype(np.int8)
+    costs = dp.static_map_values(loaded.ravel())  # the StaticLayer's mapping, costmap_2d's defaults
+    assert set(np.unique(costs)) <= {0, 254, 255}
+    assert (costs == 254).sum() == (loaded == 100).sum() > 200
+    assert (costs == 0).sum() == (loaded == 0).sum() > 1000
+    png = replayed / "costmap.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    report = (replayed / "report.md").read_text()
+    assert "x real time" in report and "`/scan`" in report
+    assert "data:image/png;base64," in (replayed / "report.html").read_text()
+
+
+def _refused(tmp_path: Path, bag: Path, capsys: pytest.CaptureFixture[str]) -> str:
+    status = replay.main(
+        [str(bag), "--config", str(CONFIG), "--out", str(tmp_path / "o"), "--quiet"]
+    )
+    assert status == 2
+    assert not (tmp_path / "o").exists()
+    return capsys.readouterr().err
+
+
+def test_a_bag_without_the_configured_topics_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    err = _refused(tmp_path, record_bag(tmp_path / "b.bag", 1.0, scan_topic="/front_scan"), capsys)
+    assert "none of the configured topics is in the bag" in err and "/front_scan" in err
+
+
+def test_a_bag_without_tf_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    err = _refused(tmp_path, record_bag(tmp_path / "b.bag", 1.0, with_tf=False), capsys)
+    assert "no /tf or /tf_static" in err
+
+
+def test_a_clock_that_jumps_back_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    err = _refused(tmp_path, record_bag(tmp_path / "b.bag", 2.0, tf_jump_at_s=1.0), capsys)
+    assert "the clock jumps back" in err and "30.0 s" in err
+
+
+def test_a_truncated_bag_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bag = record_bag(tmp_path / "b.bag", 2.0)
+    data = bag.read_bytes()
+    bag.write_bytes(data[: len(data) // 2])
+    err = _refused(tmp_path, bag, capsys)
+    assert "not indexed" in err or "not a readable bag" in err
+
+
+def test_a_source_of_the_wrong_message_type_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = yaml.safe_load(CONFIG.read_text())
+    config["obstacles"]["scan"]["data_type"] = "PointCloud2"
+    other = tmp_path / "cloud.yaml"
+    other.write_text(yaml.safe_dump(config))
+    bag = record_bag(tmp_path / "b.bag", 1.0)
+    status = replay.main(
+        [str(bag), "--config", str(other), "--out", str(tmp_path / "o"), "--quiet"]
+    )
+    assert status == 2
+    assert "sensor_msgs/LaserScan" in capsys.readouterr().err
+
+
+def test_progress_line_counts_and_estimates() -> None:
+    progress = replay.Progress(10.0, stream=None)
+    progress.counts.update({"/scan": 3, "/tf": 12})
+    progress.started = 0.0
+    line = progress.line(5.0, 2.0)
+    assert " 50.0%" in line and "ETA     2 s" in line and "/scan:3 /tf:12" in line
+
+
+def test_pgm_levels_follow_map_saver() -> None:
+    grid = np.array([[0, 25, 26, 64], [65, 100, -1, 99]], dtype=np.int8)
+    pgm = replay.occupancy_to_pgm(grid)
+    assert pgm.tolist() == [[0, 0, 205, 0], [254, 254, 205, 205]]  # flipped: top row first
