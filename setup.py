@@ -4,7 +4,7 @@ from setuptools import setup
 
 setup(
     **generate_distutils_setup(
-        packages=["downstream_perception", "downstream_perception.ros", "downstream_perception.sim"],
+        packages=["downstream_perception", "downstream_perception.replay", "downstream_perception.ros", "downstream_perception.sim"],
         package_dir={"": "src"},
     )
 )

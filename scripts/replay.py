@@ -4,7 +4,7 @@ downstream_perception.replay, or --help)."""
 
 import sys
 
-from downstream_perception.replay import main
+from downstream_perception.replay.cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

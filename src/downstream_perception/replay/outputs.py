@@ -1,0 +1,203 @@
+"""What a replay writes: the costmap as a map_server map and a PNG, the tracks as CSV and a plot,
+transform-age histograms, and the report (Markdown, and HTML with the images inline)."""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+# map_server's thresholds (map_saver --occ 65 --free 25; the YAML's occupied_thresh 0.65 and
+# free_thresh 0.196) and its grey levels.
+OCCUPIED_MIN, FREE_MAX = 65, 25
+PGM_FREE, PGM_OCCUPIED, PGM_UNKNOWN = 254, 0, 205
+TRACK_COLUMNS = [
+    "stamp", "id", "state", "label", "x", "y", "vx", "vy",
+    "pos_cov_xx", "pos_cov_xy", "pos_cov_yx", "pos_cov_yy",
+    "vel_cov_xx", "vel_cov_xy", "vel_cov_yx", "vel_cov_yy",
+    "size_x", "size_y", "score", "truth_id",
+]  # fmt: skip
+STATES = {0: "tentative", 1: "confirmed", 2: "coasting"}
+
+
+def occupancy_to_pgm(grid: np.ndarray) -> np.ndarray:
+    """map_saver's grey levels for OccupancyGrid values (row 0 = the map's bottom row)."""
+    pgm = np.full(grid.shape, PGM_UNKNOWN, dtype=np.uint8)
+    known = grid >= 0
+    pgm[known & (grid <= FREE_MAX)] = PGM_FREE
+    pgm[known & (grid >= OCCUPIED_MIN)] = PGM_OCCUPIED
+    return np.flipud(pgm)  # images start at the top row
+
+
+def write_map(
+    grid: np.ndarray, resolution: float, origin: tuple[float, float], stem: Path
+) -> tuple[Path, Path]:
+    """A map_server map: ``stem.pgm`` (binary P5) and ``stem.yaml``."""
+    pgm = occupancy_to_pgm(grid)
+    height, width = pgm.shape
+    pgm_path, yaml_path = stem.with_suffix(".pgm"), stem.with_suffix(".yaml")
+    header = f"P5\n# downstream_perception replay\n{width} {height}\n255\n".encode()
+    pgm_path.write_bytes(header + pgm.tobytes())
+    meta = {
+        "image": pgm_path.name,
+        "resolution": float(resolution),
+        "origin": [float(origin[0]), float(origin[1]), 0.0],
+        "negate": 0,
+        "occupied_thresh": OCCUPIED_MIN / 100.0,
+        "free_thresh": 0.196,
+    }
+    yaml_path.write_text(yaml.safe_dump(meta, sort_keys=False))
+    return pgm_path, yaml_path
+
+
+def read_pgm(path: Path) -> np.ndarray:
+    """A binary PGM (P5, 8 bit) as rows from the top."""
+    data = path.read_bytes()
+    tokens: list[bytes] = []
+    pos = 0
+    while len(tokens) < 4:
+        while data[pos : pos + 1].isspace():
+            pos += 1
+        if data[pos : pos + 1] == b"#":
+            pos = data.index(b"\n", pos) + 1
+            continue
+        end = pos
+        while not data[end : end + 1].isspace():
+            end += 1
+        tokens.append(data[pos:end])
+        pos = end
+    if tokens[0] != b"P5" or int(tokens[3]) != 255:
+        raise ValueError(f"{path}: not an 8-bit binary PGM")
+    width, height = int(tokens[1]), int(tokens[2])
+    pixels = np.frombuffer(data[pos + 1 : pos + 1 + width * height], dtype=np.uint8)
+    return pixels.reshape(height, width)
+
+
+def track_row(stamp: float, track: Any) -> list[Any]:
+    """One CSV row of a downstream_perception/TrackedObject."""
+    return [
+        f"{stamp:.6f}", track.id, STATES.get(track.state, str(track.state)), track.label,
+        track.position.x, track.position.y, track.velocity.x, track.velocity.y,
+        *track.position_covariance, *track.velocity_covariance,
+        track.size_x, track.size_y, track.score, track.truth_id,
+    ]  # fmt: skip
+
+
+def write_tracks_csv(rows: list[list[Any]], path: Path) -> Path:
+    with path.open("w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(TRACK_COLUMNS)
+        writer.writerows(rows)
+    return path
+
+
+def _pyplot() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def render_map_png(
+    grid: np.ndarray | None,
+    resolution: float,
+    origin: tuple[float, float],
+    path_xy: np.ndarray,
+    tracks: list[list[Any]],
+    out: Path,
+    title: str,
+) -> Path:
+    """The costmap (if any) with the robot's path and the confirmed tracks coloured by id."""
+    import matplotlib
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(9, 6))
+    if grid is not None:
+        height, width = grid.shape
+        extent = (
+            origin[0],
+            origin[0] + width * resolution,
+            origin[1],
+            origin[1] + height * resolution,
+        )
+        cmap = matplotlib.colormaps["gray_r"].copy()
+        cmap.set_bad("#7fb2b2")
+        shown = np.where(grid < 0, np.nan, grid.astype(float))
+        ax.imshow(
+            shown,
+            origin="lower",
+            extent=extent,
+            cmap=cmap,
+            vmin=0,
+            vmax=100,
+            interpolation="nearest",
+        )
+    if len(path_xy):
+        ax.plot(path_xy[:, 0], path_xy[:, 1], "-", color="#d62728", lw=1.5, label="robot path")
+        ax.plot(*path_xy[0], "o", color="#2ca02c", label="start")
+    by_id: dict[int, list[tuple[float, float]]] = {}
+    for row in tracks:
+        if row[2] == "confirmed":
+            by_id.setdefault(int(row[1]), []).append((float(row[4]), float(row[5])))
+    colours = matplotlib.colormaps["tab20"]
+    for k, (_, xy) in enumerate(sorted(by_id.items())):
+        points = np.asarray(xy)
+        ax.plot(points[:, 0], points[:, 1], "-", lw=1.0, color=colours(k % 20))
+    if by_id:
+        ax.plot([], [], "-", color=colours(0), label=f"{len(by_id)} confirmed tracks (colour = id)")
+    if len(path_xy) or by_id:
+        ax.legend(loc="upper right")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+    return out
+
+
+def render_histograms(ages: dict[str, list[float]], out: Path) -> Path | None:
+    if not any(ages.values()):
+        return None
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    for topic, values in ages.items():
+        ax.hist(np.asarray(values) * 1e3, bins=40, alpha=0.6, label=topic)
+    ax.set_xlabel("message stamp - newest /tf stamp recorded before it (ms)")
+    ax.set_ylabel("messages")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+    return out
+
+
+def _image_html(path: Path) -> str:
+    data = base64.b64encode(path.read_bytes()).decode()
+    return f'<img alt="{html.escape(path.name)}" src="data:image/png;base64,{data}">'
+
+
+def write_report(out: Path, lines: list[str], images: list[tuple[str, Path]]) -> tuple[Path, Path]:
+    """report.md (images linked) and report.html (the same text, images inline)."""
+    md_lines = list(lines)
+    for title, image in images:
+        md_lines += ["", f"## {title}", "", f"![{title}]({image.name})"]
+    md = out / "report.md"
+    md.write_text("\n".join(md_lines) + "\n")
+    body = f"<pre>{html.escape(chr(10).join(lines))}</pre>"
+    for title, image in images:
+        body += f"<h2>{html.escape(title)}</h2>{_image_html(image)}"
+    page = out / "report.html"
+    page.write_text(
+        "<!doctype html><html><head><meta charset='utf-8'><title>replay</title></head>"
+        f"<body>{body}</body></html>\n"
+    )
+    return md, page
