@@ -344,3 +344,38 @@ def test_the_mesh_and_the_octomap_are_written(tmp_path: Path) -> None:
     assert octomap.startswith(b"# Octomap OcTree binary file") and len(octomap) > 1000
     report = (out / "report.md").read_text()
     assert "TSDF mesh:" in report and "mesh.ply" in report
+
+
+def test_an_earlier_replay_is_kept_unless_overwrite_is_asked(
+    replayed: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = (replayed / "report.md").read_bytes()
+    bag = replayed.parent / "aisle.bag"
+    status = replay.main([str(bag), "--config", str(CONFIG), "--out", str(replayed), "--quiet"])
+    assert status == 2
+    assert "--overwrite" in capsys.readouterr().err
+    assert (replayed / "report.md").read_bytes() == before
+
+
+def test_the_track_log_stays_bounded(tmp_path: Path) -> None:
+    from types import SimpleNamespace
+
+    from downstream_perception.replay.outputs import TrackLog
+
+    def track(i: int, k: int, state: int = 1) -> SimpleNamespace:
+        return SimpleNamespace(
+            id=i, state=state, label="person", position=SimpleNamespace(x=k * 0.1, y=i, z=0.0),
+            velocity=SimpleNamespace(x=1.0, y=0.0, z=0.0), position_covariance=[0.01, 0, 0, 0.01],
+            velocity_covariance=[0.1, 0, 0, 0.1], size_x=0.5, size_y=0.5, score=0.9, truth_id=i,
+        )  # fmt: skip
+
+    log = TrackLog(tmp_path / "tracks.csv", max_points=1000)
+    for k in range(2000):
+        log.add(k * 0.1, [track(1, k), track(2, k), track(3, k, state=0)])
+    log.close()
+    assert log.rows == 6000
+    assert sum(len(xy) for xy in log.trajectories.values()) <= 1001
+    assert set(log.trajectories) == {1, 2}  # tentative tracks are not drawn
+    lines = (tmp_path / "tracks.csv").read_text().splitlines()
+    assert len(lines) == 6001 and lines[0].startswith("stamp,id,state,label,x,y")
+    assert lines[1].split(",")[2] == "confirmed" and lines[3].split(",")[2] == "tentative"
