@@ -1,0 +1,407 @@
+// The projective TSDF integrator: the lesson's fusion table, weights, live settings, depth images
+// and clouds, bad input.
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <random>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "downstream_perception/core/tsdf/marching_cubes.h"
+#include "downstream_perception/core/tsdf/occupancy_octree.h"
+#include "downstream_perception/core/tsdf/tsdf_health.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "tsdf_test_helpers.h"
+
+using namespace downstream_perception;        // NOLINT
+using namespace downstream_perception::test;  // NOLINT
+
+TEST(Tsdf, LessonFusionTableTwoWrongCamerasOneRightSurface) {
+  // The lesson's 1-D example: surface at x = 5, mu = 4, camera A measures 4.5, camera B 5.5,
+  // both looking along +x from the origin.
+  TsdfMap map(lessonConfig());
+  integratePoints(&map, {Eigen::Vector3d(4.5, 0, 0)}, Eigen::Vector3d::Zero());
+  const std::vector<float> camera_a = {0.375f, 0.125f, -0.125f, -0.375f, -0.625f};
+  for (int x = 3; x <= 7; ++x) EXPECT_NEAR(distanceAt(map, x), camera_a[x - 3], 1e-6) << x;
+  integratePoints(&map, {Eigen::Vector3d(5.5, 0, 0)}, Eigen::Vector3d::Zero());
+  const std::vector<float> fused = {0.5f, 0.25f, 0.0f, -0.25f, -0.5f};
+  for (int x = 3; x <= 7; ++x) {
+    EXPECT_NEAR(distanceAt(map, x), fused[x - 3], 1e-6) << x;
+    EXPECT_FLOAT_EQ(map.voxel({x, 0, 0})->weight, 2.0f);
+  }
+  // Sub-voxel crossing between x = 4 (+0.25) and x = 6 (-0.25): exactly 5.0.
+  const float d4 = distanceAt(map, 4), d6 = distanceAt(map, 6);
+  EXPECT_NEAR(4.0 + 2.0 * d4 / (d4 - d6), 5.0, 1e-9);
+  // Unequal weights move the crossing toward the heavier camera: A twice -> 4.833.
+  TsdfMap weighted(lessonConfig());
+  integratePoints(&weighted, {Eigen::Vector3d(4.5, 0, 0)}, Eigen::Vector3d::Zero());
+  integratePoints(&weighted, {Eigen::Vector3d(4.5, 0, 0)}, Eigen::Vector3d::Zero());
+  integratePoints(&weighted, {Eigen::Vector3d(5.5, 0, 0)}, Eigen::Vector3d::Zero());
+  const float w4 = distanceAt(weighted, 4), w5 = distanceAt(weighted, 5);
+  EXPECT_NEAR(4.0 + w4 / (w4 - w5), 4.0 + 0.5 / 0.6, 1e-6);  // D4 = 5/24, D5 = -1/24
+}
+
+TEST(Tsdf, MaxWeightKeepsTheMapResponsive) {
+  TsdfConfig c = lessonConfig();
+  c.max_weight = 2.0;
+  TsdfMap map(c);
+  for (int k = 0; k < 10; ++k) integratePoints(&map, {Eigen::Vector3d(4.5, 0, 0)}, {0, 0, 0});
+  EXPECT_FLOAT_EQ(map.voxel({5, 0, 0})->weight, 2.0f);
+  // The surface moves to 5.5: with the cap a few frames pull the field over (w 2 vs 1 each).
+  for (int k = 0; k < 6; ++k) integratePoints(&map, {Eigen::Vector3d(5.5, 0, 0)}, {0, 0, 0});
+  EXPECT_GT(distanceAt(map, 5), 0.1f);  // 5 is now in front of the surface
+}
+
+TEST(Tsdf, LiveSettingsChangeButTheLatticeDoesNot) {
+  TsdfConfig c = lessonConfig();
+  c.max_weight = 0.0;
+  TsdfMap map(c);
+  for (int k = 0; k < 5; ++k) integratePoints(&map, {Eigen::Vector3d(4.5, 0, 0)}, {0, 0, 0});
+  EXPECT_FLOAT_EQ(map.voxel({5, 0, 0})->weight, 5.0f);
+  // A cap set live applies to the next fusion.
+  TsdfConfig capped = map.config();
+  capped.max_weight = 3.0;
+  EXPECT_EQ(map.setConfig(capped), "");
+  integratePoints(&map, {Eigen::Vector3d(4.5, 0, 0)}, {0, 0, 0});
+  EXPECT_FLOAT_EQ(map.voxel({5, 0, 0})->weight, 3.0f);
+  // The lattice is fixed, and an invalid config changes nothing.
+  TsdfConfig other = map.config();
+  other.voxel_size_m *= 2.0;
+  EXPECT_NE(map.setConfig(other).find("fixed"), std::string::npos);
+  other = map.config();
+  other.min_depth_m = other.max_depth_m + 1.0;
+  EXPECT_FALSE(map.setConfig(other).empty());
+  EXPECT_EQ(map.config().max_weight, 3.0);
+  EXPECT_EQ(map.config().min_depth_m, capped.min_depth_m);
+}
+
+TEST(Tsdf, DepthImageOfAFrontoParallelPlaneMeshesAtItsDepth) {
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  TsdfMap map(c);
+  const PinholeCamera camera = smallCamera();
+  const double plane_z = 1.013;  // deliberately between voxel centres
+  const std::vector<float> depth = planeDepth(camera, Eigen::Vector3d::UnitZ(), plane_z);
+  const TsdfIntegrationStats stats =
+      integrateDepth(&map, depth.data(), camera, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(stats.pixels_valid, 160u * 120u);
+  EXPECT_GT(stats.voxels_updated, 0u);
+  EXPECT_EQ(stats.blocks_allocated, map.blockCount());
+  TsdfMesher mesher;
+  mesher.update(map);
+  const TriangleMesh mesh = mesher.combined();
+  ASSERT_GT(mesh.triangleCount(), 100u);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    worst = std::max(worst, std::abs(mesh.vertices[i].z() - plane_z));
+    EXPECT_LT(mesh.normals[i].z(), -0.99f);  // toward the camera (free space)
+  }
+  EXPECT_LT(worst, 2e-4);  // 0.2 mm at 5 cm voxels
+}
+
+TEST(Tsdf, DepthIntegratorReusedAcrossFramesEqualsFreshIntegration) {
+  // One DepthIntegrator keeps its per-pixel buffers between frames. Frames of another size,
+  // with the edge guard and interpolation switched off and on again between them, must give
+  // bit for bit the maps a fresh integration of each frame gives: nothing stale may leak.
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  TsdfMap reused(c), fresh(c);
+  DepthIntegrator integrator;
+  const PinholeCamera big = smallCamera();
+  PinholeCamera little = big;
+  little.width = 80;
+  little.height = 60;
+  little.fx = little.fy = 75.0;
+  little.cx = 39.5;
+  little.cy = 29.5;
+  // A slanted wall with a nearer box in front of it (depth edges), a hole and a no-return
+  // patch.
+  const auto scene = [](const PinholeCamera& camera, double wall_z) {
+    std::vector<float> depth =
+        planeDepth(camera, Eigen::Vector3d(0.3, 0.2, 1.0).normalized(), wall_z);
+    for (int v = camera.height / 4; v < camera.height / 2; ++v) {
+      for (int u = camera.width / 3; u < camera.width / 2; ++u) {
+        depth[static_cast<std::size_t>(v) * camera.width + u] = static_cast<float>(wall_z - 0.6);
+      }
+    }
+    depth[5] = std::nanf("");
+    for (int u = 0; u < camera.width / 4; ++u) {
+      depth[static_cast<std::size_t>(camera.height - 1) * camera.width + u] =
+          std::numeric_limits<float>::infinity();
+    }
+    return depth;
+  };
+  struct Frame {
+    PinholeCamera camera;
+    double wall_z;
+    bool guard_and_interpolation;
+  };
+  const Frame frames[] = {
+      {big, 2.0, true}, {little, 2.2, false}, {big, 1.9, true}, {little, 2.1, true}};
+  for (const Frame& f : frames) {
+    TsdfConfig next = c;
+    next.edge_guard_rad = f.guard_and_interpolation ? 0.02 : 0.0;
+    next.interpolate_depth = f.guard_and_interpolation;
+    ASSERT_TRUE(reused.setConfig(next).empty());
+    ASSERT_TRUE(fresh.setConfig(next).empty());
+    const std::vector<float> depth = scene(f.camera, f.wall_z);
+    Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+    T_map_camera.translation().x() = 0.03 * f.wall_z;
+    const TsdfIntegrationStats a =
+        integrator.integrate(&reused, depth.data(), f.camera, T_map_camera);
+    const TsdfIntegrationStats b = integrateDepth(&fresh, depth.data(), f.camera, T_map_camera);
+    EXPECT_EQ(a.voxels_updated, b.voxels_updated);
+    EXPECT_EQ(a.pixels_valid, b.pixels_valid);
+    EXPECT_EQ(a.pixels_invalid, b.pixels_invalid);
+    EXPECT_EQ(a.pixels_no_return, b.pixels_no_return);
+    EXPECT_GT(a.voxels_updated, 0u);
+  }
+  ASSERT_EQ(reused.blockCount(), fresh.blockCount());
+  std::size_t compared = 0;
+  for (const auto& kv : fresh.blocks()) {
+    const TsdfBlock* other = reused.find(kv.first);
+    ASSERT_NE(other, nullptr);
+    for (int i = 0; i < kTsdfBlockVoxels; ++i) {
+      ASSERT_EQ(kv.second->voxels[i].distance, other->voxels[i].distance);
+      ASSERT_EQ(kv.second->voxels[i].weight, other->voxels[i].weight);
+      compared += kv.second->voxels[i].weight > 0.0f;
+    }
+  }
+  EXPECT_GT(compared, 1000u);
+}
+
+TEST(Tsdf, EveryVoxelHoldsTheProjectiveUpdateOfItsPixel) {
+  // The integrator works on rows of eight voxels in passes and keeps earlier rows' values in
+  // its per-voxel scratch. Checked here against the update written out voxel by voxel in double
+  // precision: after one frame every voxel of every allocated block holds what its own pixel
+  // gives (or is untouched). Voxels within rounding of a decision (a pixel border, the band's
+  // end) are left out.
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  c.edge_guard_rad = 0.0;
+  const PinholeCamera camera = smallCamera();
+  std::vector<float> depth = planeDepth(camera, Eigen::Vector3d(0.3, 0.2, 1.0).normalized(), 2.0);
+  for (int v = 20; v < 60; ++v) {
+    for (int u = 50; u < 80; ++u) depth[static_cast<std::size_t>(v) * camera.width + u] = 1.3f;
+  }
+  for (int u = 0; u < 40; ++u) {
+    depth[static_cast<std::size_t>(camera.height - 1) * camera.width + u] =
+        std::numeric_limits<float>::infinity();
+    depth[static_cast<std::size_t>(u + 30) * camera.width + 100] = std::nanf("");
+  }
+  Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+  T_map_camera.linear() =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, 0.4).normalized()).toRotationMatrix();
+  T_map_camera.translation() = Eigen::Vector3d(0.11, -0.07, 0.23);
+  const double s = c.voxel_size_m, mu = c.truncation();
+  const auto valid = [&](float d) { return d >= c.min_depth_m && d <= c.max_depth_m; };
+  for (const bool interpolate : {false, true}) {
+    c.interpolate_depth = interpolate;
+    TsdfMap map(c);
+    const TsdfIntegrationStats stats = integrateDepth(&map, depth.data(), camera, T_map_camera);
+    std::size_t checked = 0, updated = 0;
+    for (const auto& kv : map.blocks()) {
+      for (int i = 0; i < kTsdfBlockVoxels; ++i) {
+        const Eigen::Vector3i voxel =
+            kv.first * kTsdfBlockSide + Eigen::Vector3i(i % 8, (i / 8) % 8, i / 64);
+        const Eigen::Vector3d p = T_map_camera.inverse() * map.voxelCenter(voxel);
+        const double u = camera.fx * p.x() / p.z() + camera.cx + 0.5;
+        const double v = camera.fy * p.y() / p.z() + camera.cy + 0.5;
+        const auto nearInteger = [](double a) { return std::abs(a - std::round(a)) < 1e-3; };
+        if (nearInteger(u) || nearInteger(v) || std::abs(p.z() - c.min_depth_m) < 1e-4) continue;
+        double expected_d = 0.0, expected_w = 0.0;  // weight 0: not updated
+        const bool in_view =
+            p.z() >= c.min_depth_m && u >= 0.0 && v >= 0.0 && u < camera.width && v < camera.height;
+        const std::size_t px =
+            in_view ? static_cast<std::size_t>(v) * camera.width + static_cast<std::size_t>(u) : 0;
+        const float nearest = depth[px];
+        double sdf = std::nan("");
+        if (in_view && nearest == std::numeric_limits<float>::infinity()) {
+          if (p.z() <= c.max_depth_m) sdf = mu;  // no return: free space
+        } else if (in_view && valid(nearest)) {
+          double d = nearest;
+          const double uf = u - 0.5, vf = v - 0.5;
+          const int u0 = static_cast<int>(uf), v0 = static_cast<int>(vf);
+          if (interpolate && uf >= 0.0 && vf >= 0.0 && u0 + 1 < camera.width &&
+              v0 + 1 < camera.height) {
+            const std::size_t k = static_cast<std::size_t>(v0) * camera.width + u0;
+            const float q[4] = {depth[k], depth[k + 1], depth[k + camera.width],
+                                depth[k + camera.width + 1]};
+            if (std::all_of(q, q + 4, valid) &&
+                *std::max_element(q, q + 4) - *std::min_element(q, q + 4) <= s) {
+              const double a = uf - u0, b = vf - v0;
+              d = 1.0 / ((1 - b) * ((1 - a) / q[0] + a / q[1]) + b * ((1 - a) / q[2] + a / q[3]));
+            }
+          }
+          const double x = (static_cast<int>(u) - camera.cx) / camera.fx;
+          const double y = (static_cast<int>(v) - camera.cy) / camera.fy;
+          sdf = std::min(mu, (d - p.z()) * std::sqrt(1.0 + x * x + y * y));
+          if (std::abs(sdf + mu) < 1e-4) continue;
+          if (sdf < -mu) sdf = std::nan("");
+        }
+        if (!std::isnan(sdf)) {
+          expected_d = std::min(1.0, sdf / mu);
+          expected_w = sdf < -s ? (mu + sdf) / (mu - s) : 1.0;  // behind-surface drop-off
+        }
+        const TsdfVoxel& got = kv.second->voxels[i];
+        ASSERT_NEAR(got.weight, expected_w, 1e-4) << "voxel " << voxel.transpose();
+        if (expected_w > 0.0) {
+          ASSERT_NEAR(got.distance, expected_d, 1e-4) << "voxel " << voxel.transpose();
+          ++updated;
+        }
+        ++checked;
+      }
+    }
+    EXPECT_GT(updated, 15000u);
+    EXPECT_GT(checked, updated + 15000u);  // also many voxels the frame leaves untouched
+    EXPECT_GE(stats.voxels_updated, updated);
+  }
+}
+
+TEST(Tsdf, ObliquePlaneFromSeveralViewsIsUnbiased) {
+  // Nearest-pixel rounding (not truncation) and the range-along-ray sdf: vertices of a plane
+  // tilted 40 degrees, fused from three camera positions, lie on it (no half-pixel bias).
+  TsdfConfig c;
+  c.voxel_size_m = 0.02;
+  TsdfMap map(c);
+  const PinholeCamera camera = smallCamera();
+  const Eigen::Vector3d n_map = Eigen::Vector3d(0.0, std::sin(0.7), -std::cos(0.7));
+  const double offset_map = -1.5;  // plane n . p = offset in the map frame
+  for (double shift : {-0.2, 0.0, 0.2}) {
+    Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+    T_map_camera.translation() = Eigen::Vector3d(shift, 0.0, 0.0);
+    // In the camera frame (translation only): n . (p_c + t) = offset.
+    const double offset_camera = offset_map - n_map.dot(T_map_camera.translation());
+    const std::vector<float> depth = planeDepth(camera, n_map, offset_camera);
+    integrateDepth(&map, depth.data(), camera, T_map_camera);
+  }
+  TsdfMesher mesher;
+  mesher.update(map);
+  const TriangleMesh mesh = mesher.combined();
+  ASSERT_GT(mesh.vertices.size(), 1000u);
+  double sum = 0.0, sum_abs = 0.0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    const double e = n_map.dot(v.cast<double>()) - offset_map;
+    sum += e;
+    sum_abs += std::abs(e);
+  }
+  const double n = static_cast<double>(mesh.vertices.size());
+  EXPECT_LT(std::abs(sum / n), 2e-4);  // bias < 0.2 mm
+  EXPECT_LT(sum_abs / n, 1e-3);        // mean error < 1 mm at 2 cm voxels
+}
+
+TEST(Tsdf, InvalidDepthsAreCountedNotFused) {
+  TsdfMap map;
+  PinholeCamera camera = smallCamera();
+  camera.width = 4;
+  camera.height = 1;
+  camera.cx = 1.5;
+  camera.cy = 0.0;
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> depth = {std::nanf(""), 0.0f, -inf, inf};
+  const TsdfIntegrationStats s =
+      integrateDepth(&map, depth.data(), camera, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(s.pixels_invalid, 3u);
+  EXPECT_EQ(s.pixels_no_return, 1u);
+  EXPECT_EQ(s.pixels_valid, 0u);
+  EXPECT_EQ(map.blockCount(), 0u);  // no return alone allocates nothing
+  PinholeCamera bad = camera;
+  bad.fx = std::nan("");
+  EXPECT_FALSE(bad.validate().empty());
+  TsdfConfig absurd;
+  absurd.voxel_size_m = -1.0;
+  EXPECT_THROW(TsdfMap{absurd}, std::invalid_argument);
+  absurd = TsdfConfig{};
+  absurd.min_depth_m = 5.0;
+  absurd.max_depth_m = 1.0;
+  EXPECT_FALSE(absurd.validate().empty());
+}
+
+TEST(Tsdf, CameraWithAPrincipalPointFarOutsideOrAnAbsurdViewIsRefused) {
+  PinholeCamera far = smallCamera();
+  far.cx = 1e7;  // made one carving frame allocate every block the map allowed
+  EXPECT_NE(far.validate().find("principal point"), std::string::npos) << far.validate();
+  PinholeCamera edge = smallCamera();
+  edge.cx = 3.0 * edge.width;  // two image widths beyond the image: still accepted
+  edge.cy = -2.0 * edge.height;
+  EXPECT_EQ(edge.validate(), "");
+  edge.cy -= 1.0;
+  EXPECT_NE(edge.validate().find("principal point"), std::string::npos);
+  PinholeCamera wide = smallCamera();
+  wide.fx = 5.0;  // the image's edge 16 focal lengths off the axis
+  EXPECT_NE(wide.validate().find("view too wide"), std::string::npos) << wide.validate();
+
+  // The integrator refuses such a frame itself (a caller that did not validate): nothing
+  // allocated, every pixel counted invalid.
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  c.carve_free_space = true;
+  c.max_blocks = 2000;
+  TsdfMap map(c);
+  const std::vector<float> depth(static_cast<std::size_t>(far.width) * far.height, 1.0f);
+  const TsdfIntegrationStats s =
+      integrateDepth(&map, depth.data(), far, Eigen::Isometry3d::Identity());
+  ASSERT_NE(s.refused, nullptr);
+  EXPECT_EQ(map.blockCount(), 0u);
+  EXPECT_EQ(s.pixels_invalid, depth.size());
+  EXPECT_EQ(s.pixels_valid, 0u);
+}
+
+TEST(Tsdf, FarAndNanPointsAreInvalidNotOverflowed) {
+  // Points, sensor origins and camera poses whose voxel index would not fit in an int (5e9
+  // voxels at 2 cm: 1e8 m) or NaN are refused and counted as invalid; before, the float-to-int
+  // conversion overflowed (undefined; in practice blocks at INT_MIN were allocated).
+  TsdfMap map;
+  const double far = 1e8;
+  const std::vector<Eigen::Vector3d> near_far_origin = {Eigen::Vector3d(far + 1.0, 0.0, 0.0)};
+  TsdfIntegrationStats s = integratePoints(&map, near_far_origin, Eigen::Vector3d(far, 0.0, 0.0));
+  EXPECT_NE(s.refused, nullptr);
+  EXPECT_EQ(s.pixels_invalid, 1u);
+  EXPECT_EQ(s.pixels_valid, 0u);
+  EXPECT_EQ(map.blockCount(), 0u);
+  const double nan = std::nan("");
+  s = integratePoints(&map, {Eigen::Vector3d(nan, 0.0, 1.0), Eigen::Vector3d(0.0, 0.0, 1.0)},
+                      Eigen::Vector3d::Zero());
+  EXPECT_EQ(s.refused, nullptr);
+  EXPECT_EQ(s.pixels_invalid, 1u);
+  EXPECT_EQ(s.pixels_valid, 1u);
+  const std::size_t blocks = map.blockCount();
+  EXPECT_GT(blocks, 0u);
+  s = integratePoints(&map, near_far_origin, Eigen::Vector3d(nan, 0.0, 0.0));
+  EXPECT_NE(s.refused, nullptr);
+
+  const PinholeCamera camera = smallCamera();
+  const std::vector<float> wall = planeDepth(camera, Eigen::Vector3d::UnitZ(), 1.0);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation().x() = far;
+  s = integrateDepth(&map, wall.data(), camera, T);
+  EXPECT_NE(s.refused, nullptr);
+  EXPECT_EQ(s.pixels_invalid, wall.size());
+  T.translation().x() = 0.0;
+  T.linear()(0, 0) = nan;
+  s = integrateDepth(&map, wall.data(), camera, T);
+  EXPECT_NE(s.refused, nullptr);
+  EXPECT_EQ(map.blockCount(), blocks);
+
+  // Queries: no voxel for far or NaN points (voxelAt clamps instead of overflowing).
+  EXPECT_NE(map.voxelNear(Eigen::Vector3d(0.0, 0.0, 1.0)), nullptr);
+  EXPECT_EQ(map.voxelNear(Eigen::Vector3d(nan, 0.0, 1.0)), nullptr);
+  EXPECT_EQ(map.voxelNear(Eigen::Vector3d(1e300, 0.0, 1.0)), nullptr);
+  EXPECT_EQ(map.voxelAt(Eigen::Vector3d(-1e300, nan, 0.02)),
+            Eigen::Vector3i(-TsdfMap::kMaxVoxelIndex, 0, 1));
+  // Any index, even INT_MIN, gives its block without overflow.
+  const int lowest = std::numeric_limits<int>::min();
+  EXPECT_EQ(TsdfMap::blockOf(Eigen::Vector3i(lowest, -1, -9)),
+            Eigen::Vector3i(lowest / kTsdfBlockSide, -1, -2));
+  EXPECT_EQ(TsdfMap::localIndex(Eigen::Vector3i(lowest, -1, -9)), TsdfBlock::linear(0, 7, 7));
+  EXPECT_FALSE(map.inBounds(Eigen::Vector3d(far, 0.0, 0.0)));
+  EXPECT_TRUE(map.inBounds(Eigen::Vector3d(1e6, -1e6, 1e6)));
+}
