@@ -22,17 +22,14 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   std::string mode;
   pnh_.param("mode", mode, std::string("metric"));
   if (mode != "metric" && mode != "image") {
-    const std::string msg = "parameter ~mode = '" + mode + "' is invalid; using 'metric'";
-    ROS_ERROR("tracker: %s", msg.c_str());
-    config_errors_.push_back(msg);
+    config_errors_.add("parameter ~mode = '" + mode + "' is invalid; using 'metric'");
     mode = "metric";
   }
   image_mode_ = mode == "image";
   int tf_queue_size = 20;
   pnh_.param("tf_queue_size", tf_queue_size, 20);
   if (tf_queue_size < 1 || tf_queue_size > 10000) {
-    config_errors_.push_back("parameter ~tf_queue_size must be in [1, 10000]; using 20");
-    ROS_ERROR("tracker: %s", config_errors_.back().c_str());
+    config_errors_.add("parameter ~tf_queue_size must be in [1, 10000]; using 20");
     tf_queue_size = 20;
   }
   TrackerConfig config;
@@ -46,9 +43,7 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   // The server reads the YAML values (or the .cfg defaults, equal to TrackerConfig's) and calls
   // reconfigure() at once: one code path for start-up and live changes.
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback(boost::bind(&TrackerRos::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(pnh_, this, &TrackerRos::reconfigure);
 
   if (image_mode_) {
     // Image boxes stay in their camera frame: no transform.
@@ -93,7 +88,7 @@ void TrackerRos::watchClock(const ros::SteadyTimerEvent&) {
 
 TrackerRos::~TrackerRos() {
   clock_watch_.stop();
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   filtered_.unsubscribe();
   subscriber_.reset();
 }
@@ -117,18 +112,8 @@ void TrackerRos::reconfigure(TrackerNodeConfig& c, std::uint32_t) {
   try {
     tracker_->setConfig(next);
   } catch (const std::invalid_argument& e) {
-    const std::string msg = std::string(e.what()) + "; keeping the previous settings";
-    ROS_ERROR("%s", msg.c_str());
-    config_errors_.push_back(msg);
+    config_errors_.add(std::string(e.what()) + "; keeping the previous settings");
   }
-}
-
-void TrackerRos::reject(const std::string& reason, const std::string& detail) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++rejected_[reason];
-  }
-  ROS_WARN_THROTTLE(2.0, "tracker: detections rejected: %s: %s", reason.c_str(), detail.c_str());
 }
 
 void TrackerRos::onTfFailure(const DetectedObjectArrayConstPtr& msg,
@@ -136,7 +121,7 @@ void TrackerRos::onTfFailure(const DetectedObjectArrayConstPtr& msg,
   std::ostringstream detail;
   detail << "frame '" << msg->header.frame_id << "' -> '" << tracking_frame_ << "' at stamp "
          << msg->header.stamp;
-  reject(tfFailureReason(reason), detail.str());
+  rejected_.reject(tfFailureReason(reason), detail.str());
 }
 
 bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* out,
@@ -198,7 +183,7 @@ bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* 
 
 void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
-    reject("bad message: zero stamp", "detections must carry their measurement time");
+    rejected_.reject("bad message: zero stamp", "detections must carry their measurement time");
     return;
   }
   {
@@ -206,7 +191,7 @@ void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
     std::vector<Detection> detections;
     std::string why;
     if (!toCore(*msg, &detections, &why)) {
-      ++rejected_["tf: lookup at stamp failed"];
+      rejected_.count("tf: lookup at stamp failed");
       ROS_WARN_THROTTLE(2.0, "tracker: %s", why.c_str());
       return;
     }
@@ -214,7 +199,7 @@ void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
     try {
       last_ = tracker_->step(msg->header.stamp.toSec(), detections);
     } catch (const std::invalid_argument& e) {
-      ++rejected_["bad message: stamp older than the previous frame"];
+      rejected_.count("bad message: stamp older than the previous frame");
       ROS_WARN_THROTTLE(2.0, "tracker: %s", e.what());
       return;
     }
@@ -262,11 +247,7 @@ void TrackerRos::publish(const std_msgs::Header& header) {
 
 void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::size_t rejected = 0;
-  for (const auto& [reason, count] : rejected_) {
-    status.add("rejected (" + reason + ")", count);
-    rejected += count;
-  }
+  const std::size_t rejected = rejected_.report(status);
   status.add("frames", frames_);
   status.add("clock jumps back (tracks reset)", clock_jump_.jumps());
   status.add("tracks alive", last_.tracks);
@@ -285,10 +266,11 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("ID switches vs truth ids (total)", total_.id_switches);
   status.add("step time mean (us)", step_us_.mean());
   status.add("step time max (us)", step_us_.max);
-  addConfigErrors(status, config_errors_);
+  const std::vector<std::string> config_errors = config_errors_.all();
+  addConfigErrors(status, config_errors);
   const std::size_t waiting = addTfWaits(status, "", filtered_.waitingForTf());
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  if (!config_errors.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors.front());
   } else if (waiting > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    std::to_string(waiting) + " message(s) waiting for tf (see 'waiting for tf')");

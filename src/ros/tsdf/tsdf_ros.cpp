@@ -43,7 +43,7 @@ void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
         std::ostringstream detail;
         detail << what << " in '" << m->header.frame_id << "' at stamp " << m->header.stamp;
-        reject(tfFailureReason(reason), detail.str());
+        rejected_.reject(tfFailureReason(reason), detail.str());
       });
 }
 
@@ -142,9 +142,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", tf_queue_size);
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
   mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback(
-      boost::bind(&TsdfRos::reconfigure, this, boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(pnh_, this, &TsdfRos::reconfigure);
   const TsdfConfig& c = map_->config();
   ROS_INFO(
       "tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s; files saved "
@@ -156,7 +154,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 TsdfRos::~TsdfRos() {
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   mesh_timer_.stop();
   depth_subscriber_.shutdown();
   cloud_subscriber_.shutdown();
@@ -216,14 +214,6 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
            now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m);
 }
 
-void TsdfRos::reject(const std::string& reason, const std::string& detail) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++rejected_[reason];
-  }
-  ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s: %s", reason.c_str(), detail.c_str());
-}
-
 bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::string* why) {
   try {
     *T =
@@ -242,7 +232,7 @@ void TsdfRos::onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
 
 void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
   if (stats.refused != nullptr) {  // counted as rejected, like the node's own checks
-    ++rejected_[std::string("integrator: ") + stats.refused];
+    rejected_.count(std::string("integrator: ") + stats.refused);
     ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s", stats.refused);
     return;
   }
@@ -277,15 +267,15 @@ bool TsdfRos::cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, 
 
 void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
-    reject("bad message: zero stamp", "depth images must carry their measurement time");
+    rejected_.reject("bad message: zero stamp", "depth images must carry their measurement time");
     return;
   }
   std::string why;
   PinholeCamera camera;
   if (!checkDepthImage(*msg, &why)) {  // converted once, after tf, in onDepth()
-    reject("bad depth image", why);
+    rejected_.reject("bad depth image", why);
   } else if (!cameraFor(*msg, &camera, &why)) {
-    reject("camera_info missing or inconsistent", why);
+    rejected_.reject("camera_info missing or inconsistent", why);
   } else {
     depth_filter_.add(msg);
   }
@@ -298,11 +288,11 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
   Eigen::Isometry3d T_world_camera;
   // Checked on arrival already; the CameraInfo may have changed while waiting for tf.
   if (!depthImageToMetres(*msg, &metres, &why) || !cameraFor(*msg, &camera, &why)) {
-    reject("camera_info missing or inconsistent", why);
+    rejected_.reject("camera_info missing or inconsistent", why);
     return;
   }
   if (!lookup(msg->header, &T_world_camera, &why)) {
-    reject("tf: lookup at stamp failed", why);
+    rejected_.reject("tf: lookup at stamp failed", why);
     return;
   }
   {
@@ -321,12 +311,12 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
 
 void TsdfRos::onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
-    reject("bad message: zero stamp", "point clouds must carry their measurement time");
+    rejected_.reject("bad message: zero stamp", "point clouds must carry their measurement time");
     return;
   }
   const std::string why = checkCloudLayout(*msg);  // the layout every cloud consumer checks
   if (!why.empty()) {
-    reject("bad point cloud", why);
+    rejected_.reject("bad point cloud", why);
     return;
   }
   cloud_filter_.add(msg);
@@ -336,7 +326,7 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   Eigen::Isometry3d T_world_sensor;
   std::string why;
   if (!lookup(msg->header, &T_world_sensor, &why)) {
-    reject("tf: lookup at stamp failed", why);
+    rejected_.reject("tf: lookup at stamp failed", why);
     return;
   }
   std::size_t x_offset = 0;
@@ -488,11 +478,7 @@ bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
 
 void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::size_t rejected = 0;
-  for (const auto& [reason, count] : rejected_) {
-    status.add("rejected (" + reason + ")", count);
-    rejected += count;
-  }
+  const std::size_t rejected = rejected_.report(status);
   status.add("frames integrated", frames_integrated_);
   status.add("frames rejected", rejected);
   status.add("integration time mean (ms)", integrate_ms_.mean());
