@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "downstream_perception/ros/common/config_errors.h"
-#include "downstream_perception/ros/common/track_transform.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/tf_failure.h"
 
 namespace downstream_perception {

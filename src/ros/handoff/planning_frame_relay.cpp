@@ -2,7 +2,7 @@
 
 #include <tf2_sensor_msgs/tf2_sensor_msgs.h>
 
-#include "downstream_perception/ros/common/track_transform.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/common/tf_failure.h"
 

@@ -12,6 +12,7 @@
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/common/save_service.h"
 #include "downstream_perception/ros/common/tf_failure.h"
@@ -19,19 +20,6 @@
 #include "downstream_perception/ros/tsdf/tsdf_slice_messages.h"
 
 namespace downstream_perception {
-
-namespace {
-
-Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
-  return T;
-}
-
-}  // namespace
 
 template <class M>
 void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
