@@ -1,9 +1,5 @@
 #include "downstream_perception/ros/tracking/tracker_ros.h"
 
-#include <tf2/LinearMath/Matrix3x3.h>
-#include <tf2/LinearMath/Quaternion.h>
-#include <tf2/LinearMath/Transform.h>
-
 #include <Eigen/Core>
 
 #include <chrono>
@@ -12,6 +8,7 @@
 
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/tf_failure.h"
 
 namespace downstream_perception {
@@ -126,22 +123,19 @@ void TrackerRos::onTfFailure(const DetectedObjectArrayConstPtr& msg,
 
 bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* out,
                         std::string* why) {
-  tf2::Transform to_tracking;
-  to_tracking.setIdentity();
+  Eigen::Isometry3d to_tracking = Eigen::Isometry3d::Identity();
   if (!image_mode_) {
     try {
-      const auto t =
-          tf_buffer_->lookupTransform(tracking_frame_, msg.header.frame_id, msg.header.stamp);
-      const auto& q = t.transform.rotation;
-      const auto& p = t.transform.translation;
-      to_tracking =
-          tf2::Transform(tf2::Quaternion(q.x, q.y, q.z, q.w), tf2::Vector3(p.x, p.y, p.z));
+      to_tracking = toEigen(
+          tf_buffer_->lookupTransform(tracking_frame_, msg.header.frame_id, msg.header.stamp)
+              .transform);
     } catch (const tf2::TransformException& e) {
       *why = std::string("tf: lookup at stamp failed: ") + e.what();
       return false;
     }
   }
-  const tf2::Matrix3x3& r = to_tracking.getBasis();
+  // The top-left 2 x 2 of the rotation turns the planar covariances: C' = R C R^T.
+  const Eigen::Matrix2d rot = to_tracking.linear().topLeftCorner<2, 2>();
   for (const auto& d : msg.detections) {
     if (d.kind != DetectedObject::BOX && d.kind != DetectedObject::POSITION) {
       ++detections_unknown_kind_;  // neither a box nor a position: nothing to read
@@ -161,18 +155,15 @@ bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* 
       }
       c.box = {d.x_min, d.y_min, d.x_max, d.y_max};
     } else {
-      const tf2::Vector3 p = to_tracking * tf2::Vector3(d.position.x, d.position.y, d.position.z);
+      const Eigen::Vector3d p =
+          to_tracking * Eigen::Vector3d(d.position.x, d.position.y, d.position.z);
       c.x = p.x();
       c.y = p.y();
-      // Rotate the planar covariance: C' = R C R^T (the top-left 2 x 2 of the rotation).
-      Eigen::Matrix2d rot, cov;
-      rot << r[0][0], r[0][1], r[1][0], r[1][1];
-      cov << d.position_covariance[0], d.position_covariance[1], d.position_covariance[2],
-          d.position_covariance[3];
-      const Eigen::Matrix2d rotated = rot * cov * rot.transpose();
-      c.cov_xx = rotated(0, 0);
-      c.cov_xy = 0.5 * (rotated(0, 1) + rotated(1, 0));
-      c.cov_yy = rotated(1, 1);
+      boost::array<double, 4> cov = d.position_covariance;
+      rotateCovariance(rot, &cov);
+      c.cov_xx = cov[0];
+      c.cov_xy = 0.5 * (cov[1] + cov[2]);
+      c.cov_yy = cov[3];
       c.size_x = d.size_x;
       c.size_y = d.size_y;
     }
