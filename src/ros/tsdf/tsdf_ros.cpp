@@ -40,69 +40,16 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   config_errors_.setPrefix("tsdf");
   pnh_.param("world_frame", world_frame_, std::string("odom"));
   output_directory_ = readOutputDirectory(pnh_, &config_errors_);
-  double mesh_rate_hz = 1.0;
-  pnh_.param("mesh_rate_hz", mesh_rate_hz, mesh_rate_hz);
-  if (!(std::isfinite(mesh_rate_hz) && mesh_rate_hz > 0.0 && mesh_rate_hz <= 100.0)) {
-    config_errors_.add("parameter ~mesh_rate_hz = " + toText(mesh_rate_hz) +
-                       " must be in (0, 100] Hz; using 1");
-    mesh_rate_hz = 1.0;
-  }
-  pnh_.param("health_period_s", health_period_s_, health_period_s_);
-  if (!(std::isfinite(health_period_s_) && health_period_s_ >= 0.0)) {
-    config_errors_.add("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
-    health_period_s_ = 10.0;
-  }
-  pnh_.param("slice_min_z_m", slice_.min_z_m, slice_.min_z_m);
-  pnh_.param("slice_max_z_m", slice_.max_z_m, slice_.max_z_m);
-  const std::string slice_why = slice_.validate();
-  if (!slice_why.empty()) {
-    config_errors_.add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
-    slice_ = TsdfSliceConfig{};
-  }
-  pnh_.param("slice_distance_max_m", slice_distance_max_m_, slice_distance_max_m_);
-  if (!(std::isfinite(slice_distance_max_m_) && slice_distance_max_m_ >= 0.0 &&
-        slice_distance_max_m_ <= 100.0)) {
-    config_errors_.add("parameter ~slice_distance_max_m = " + toText(slice_distance_max_m_) +
-                       " must be in [0, 100] m (0 = off); using 2");
-    slice_distance_max_m_ = 2.0;
-  }
-  int tf_queue_size = 10;
-  pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
-  if (tf_queue_size < 1 || tf_queue_size > 1000) {
-    config_errors_.add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
-    tf_queue_size = 10;
-  }
+  const TsdfNodeSettings settings = readTsdfNodeSettings(pnh_, &config_errors_);
+  health_period_s_ = settings.health_period_s;
+  slice_ = settings.slice;
+  slice_distance_max_m_ = settings.slice_distance_max_m;
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
-  OctreeConfig octree;
-  pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
-  pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
-  octree.max_range_m = map_->config().max_depth_m;
-  octree.max_distance_m = map_->config().max_block_distance_m;  // the TSDF's bound
-  double octree_max_memory_mb = static_cast<double>(octree.max_memory_bytes) / (1 << 20);
-  pnh_.param("octomap_max_memory_mb", octree_max_memory_mb, octree_max_memory_mb);
-  if (!(std::isfinite(octree_max_memory_mb) && octree_max_memory_mb >= 1.0 &&
-        octree_max_memory_mb <= 1e6)) {
-    config_errors_.add("parameter ~octomap_max_memory_mb = " + toText(octree_max_memory_mb) +
-                       " must be in [1, 1e6] MiB; using 256");
-    octree_max_memory_mb = 256.0;
-  }
-  octree.max_memory_bytes = static_cast<std::size_t>(octree_max_memory_mb * (1 << 20));
-  int octree_queue = 2;
-  pnh_.param("octomap_queue_size", octree_queue, octree_queue);
-  if (octree_queue < 1 || octree_queue > 100) {
-    config_errors_.add("parameter ~octomap_queue_size must be in [1, 100]; using 2");
-    octree_queue = 2;
-  }
-  if (octree.resolution_m > 0.0) {  // 0 turns the OctoMap off
-    const std::string why = octree.validate();
-    if (!why.empty()) {
-      config_errors_.add("OctoMap parameters invalid (" + why + "); using the defaults");
-      octree = OctreeConfig{};
-      octree.max_distance_m = map_->config().max_block_distance_m;
-    }
-    octree_max_memory_bytes_ = octree.max_memory_bytes;
-    octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octree),
-                                             static_cast<std::size_t>(octree_queue));
+  const OctomapSettings octomap = readOctomapSettings(pnh_, map_->config(), &config_errors_);
+  if (octomap.enabled()) {  // ~octomap_resolution_m = 0 turns the OctoMap off
+    octree_max_memory_bytes_ = octomap.octree.max_memory_bytes;
+    octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octomap.octree),
+                                             static_cast<std::size_t>(octomap.queue_size));
   }
 
   mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
@@ -125,11 +72,12 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   // Raw subscribers check each message first (a wrong encoding is reported at once instead of
   // waiting for tf) and pass it to a tf2 MessageFilter, which holds it until the transform to
   // the world frame at its stamp exists.
-  attachTfFilter(&depth_filter_, &TsdfRos::onDepth, "depth image", tf_queue_size);
+  attachTfFilter(&depth_filter_, &TsdfRos::onDepth, "depth image", settings.tf_queue_size);
   depth_subscriber_ = nh_.subscribe("depth/image", 5, &TsdfRos::onDepthRaw, this);
-  attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", tf_queue_size);
+  attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", settings.tf_queue_size);
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
-  mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
+  mesh_timer_ =
+      pnh_.createTimer(ros::Duration(1.0 / settings.mesh_rate_hz), &TsdfRos::publishMesh, this);
   reconfigure_.start(pnh_, this, &TsdfRos::reconfigure);
   const TsdfConfig& c = map_->config();
   ROS_INFO(
