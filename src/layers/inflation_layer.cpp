@@ -19,9 +19,7 @@ void InflationLayer::onInitialize() {
   param_warnings_ = params.warnings();
   // The server reads the YAML values (or the .cfg defaults, equal to InflationConfig's) and calls
   // reconfigure() at once: one code path for start-up and live changes.
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
-  reconfigure_server_->setCallback(boost::bind(&InflationLayer::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(nh_, this, &InflationLayer::reconfigure);
 }
 
 void InflationLayer::reconfigure(InflationLayerConfig& cfg, std::uint32_t) {

@@ -31,7 +31,7 @@ constexpr double kSourceWarnPeriodS = 10.0;
 
 LogOddsObstacleLayer::~LogOddsObstacleLayer() {
   // Stop the callbacks before the grid they write into goes away.
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   track_inbox_.unsubscribe();
   sources_.clear();
 }
@@ -95,9 +95,7 @@ void LogOddsObstacleLayer::onInitialize() {
   }
   // The server reads the YAML values (or the .cfg defaults, equal to the C++ ones) and calls
   // reconfigure() once at once: one code path for start-up and live changes.
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
-  reconfigure_server_->setCallback(boost::bind(&LogOddsObstacleLayer::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(nh_, this, &LogOddsObstacleLayer::reconfigure);
 }
 
 void LogOddsObstacleLayer::warnParam(const std::string& msg) {
@@ -637,11 +635,7 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     status.add(p + "data type", source->dataType());
     status.add(p + "messages received", h.received);
     status.add(p + "messages integrated", h.integrated);
-    std::size_t rejected = 0;
-    for (const auto& [reason, count] : h.rejected) {
-      status.add(p + "rejected (" + reason + ")", count);
-      rejected += count;
-    }
+    const std::size_t rejected = source->rejections().report(status, p);
     for (const auto& [what, count] : h.notes) status.add(p + what, count);
     rejected_total += rejected;
     status.add(p + "messages rejected", rejected);
@@ -682,10 +676,7 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     std::lock_guard<std::mutex> lock(param_warnings_mutex_);
     param_warnings = param_warnings_;
   }
-  status.add("parameter warnings", param_warnings.size());
-  for (std::size_t k = 0; k < param_warnings.size(); ++k) {
-    status.add("parameter warning " + std::to_string(k + 1), param_warnings[k]);
-  }
+  addParamWarnings(status, param_warnings);
   if (config_errors_.report(status)) return;  // ERROR, with the first problem
   if (!not_current.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "not current: " + not_current);

@@ -51,7 +51,7 @@ StaticLayer::~StaticLayer() {
   wait_timer_.stop();
   map_sub_.shutdown();
   update_sub_.shutdown();
-  reconfigure_server_.reset();
+  reconfigure_.stop();
 }
 
 void StaticLayer::readParameters() {
@@ -97,9 +97,7 @@ void StaticLayer::onInitialize() {
   current_ = false;  // until the first map (costmap_2d blocks here instead)
   resolved_topic_ = topic_nh_.resolveName(map_topic_);
   subscribe();
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
-  reconfigure_server_->setCallback(boost::bind(&StaticLayer::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(nh_, this, &StaticLayer::reconfigure);
   wait_timer_ =
       topic_nh_.createWallTimer(ros::WallDuration(kWaitWarnFirstS), &StaticLayer::waitWarn, this);
   const std::string updates = subscribe_to_updates_ ? " and " + resolved_topic_ + "_updates" : "";
@@ -358,10 +356,7 @@ void StaticLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) 
   status.add("free cells", c.free);
   status.add("scaled cells", c.other);
   if (layered_costmap_->isRolling()) status.add("transform failures", tf_failures_);
-  status.add("parameter warnings", param_warnings_.size());
-  for (std::size_t k = 0; k < param_warnings_.size(); ++k) {
-    status.add("parameter warning " + std::to_string(k + 1), param_warnings_[k]);
-  }
+  addParamWarnings(status, param_warnings_);
   using diagnostic_msgs::DiagnosticStatus;
   if (!enabled_) {
     status.summary(DiagnosticStatus::OK, "disabled");

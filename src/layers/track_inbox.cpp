@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/tf_failure.h"
-#include "downstream_perception/ros/common/track_transform.h"
 
 namespace downstream_perception {
 
@@ -37,6 +37,7 @@ void TrackInbox::subscribe(ros::NodeHandle& nh, tf2_ros::Buffer& tf,
   tf_ = &tf;
   global_frame_ = global_frame;
   const TrackInboxConfig c = config();
+  setLogPrefix(c.topic);
   subscription_.subscribe(
       nh, c.topic, tf, global_frame, c.tf_queue_size,
       [this](const TrackedObjectArrayConstPtr& msg) { onTracks(msg); },
@@ -45,7 +46,7 @@ void TrackInbox::subscribe(ros::NodeHandle& nh, tf2_ros::Buffer& tf,
         std::ostringstream detail;
         detail << "frame '" << msg->header.frame_id << "' -> '" << global_frame_ << "' at stamp "
                << msg->header.stamp;
-        reject(tfFailureReason(reason), detail.str());
+        rejected_.reject(tfFailureReason(reason), detail.str());
       });
 }
 
@@ -54,8 +55,15 @@ void TrackInbox::unsubscribe() {
 }
 
 void TrackInbox::setConfig(const TrackInboxConfig& config) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  config_ = config;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    config_ = config;
+  }
+  setLogPrefix(config.topic);
+}
+
+void TrackInbox::setLogPrefix(const std::string& topic) {
+  rejected_.setLogPrefix("layer '" + owner_ + "' (" + topic + ")");
 }
 
 TrackInboxConfig TrackInbox::config() const {
@@ -63,24 +71,12 @@ TrackInboxConfig TrackInbox::config() const {
   return config_;
 }
 
-void TrackInbox::reject(const std::string& reason, const std::string& detail) {
-  std::string topic;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++rejected_[reason];
-    last_rejection_ = reason + ": " + detail;
-    topic = config_.topic;
-  }
-  ROS_WARN_THROTTLE(2.0, "layer '%s' (%s): %s: %s", owner_.c_str(), topic.c_str(), reason.c_str(),
-                    detail.c_str());
-}
-
 void TrackInbox::onTracks(const TrackedObjectArrayConstPtr& msg) {
   geometry_msgs::TransformStamped transform;
   try {
     transform = tf_->lookupTransform(global_frame_, msg->header.frame_id, msg->header.stamp);
   } catch (const tf2::TransformException& e) {
-    reject("tf: lookup at stamp failed", e.what());
+    rejected_.reject("tf: lookup at stamp failed", e.what());
     return;
   }
   const TrackInboxConfig c = config();
@@ -106,14 +102,14 @@ void TrackInbox::onTracks(const TrackedObjectArrayConstPtr& msg) {
     t.box_yaw = box_yaw;
     const std::string why = t.validate();
     if (!why.empty()) {
-      reject("bad track", "id " + std::to_string(object.id) + ": " + why);
+      rejected_.reject("bad track", "id " + std::to_string(object.id) + ": " + why);
       continue;
     }
     tracks.push_back(t);
   }
   std::lock_guard<std::mutex> lock(mutex_);
   if (!stamp_.isZero() && msg->header.stamp < stamp_) {
-    ++rejected_["older than the tracks already held"];
+    rejected_.count("older than the tracks already held");
     return;
   }
   tracks_ = std::move(tracks);
@@ -158,8 +154,7 @@ std::size_t TrackInbox::arraysReceived() const {
 }
 
 std::string TrackInbox::lastRejection() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return last_rejection_;
+  return rejected_.last();
 }
 
 void TrackInbox::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status,
@@ -169,10 +164,9 @@ void TrackInbox::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status,
   status.add(prefix + "track arrays received", arrays_received_);
   status.add(prefix + "track arrays expired (older than track_timeout_s)", arrays_expired_);
   status.add(prefix + "tracks skipped by state", tracks_skipped_state_);
-  for (const auto& [reason, count] : rejected_) {
-    status.add(prefix + "rejected (" + reason + ")", count);
-  }
-  if (!last_rejection_.empty()) status.add(prefix + "last rejection", last_rejection_);
+  rejected_.report(status, prefix);
+  const std::string last = rejected_.last();
+  if (!last.empty()) status.add(prefix + "last rejection", last);
   status.add(prefix + "transform age mean (s)", transform_age_s_.mean());
   status.add(prefix + "transform age max (s)", transform_age_s_.max);
   status.add(prefix + "track_timeout_s", config_.track_timeout_s);

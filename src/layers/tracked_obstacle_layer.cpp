@@ -14,7 +14,7 @@ namespace downstream_perception {
 
 TrackedObstacleLayer::~TrackedObstacleLayer() {
   // Stop the callbacks before the state they write into goes away.
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   inbox_.unsubscribe();
 }
 
@@ -36,9 +36,7 @@ void TrackedObstacleLayer::onInitialize() {
   current_ = false;
   // The server reads the YAML values (or the .cfg defaults, equal to the C++ ones) and calls
   // reconfigure() at once: one code path for start-up and live changes.
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, nh_);
-  reconfigure_server_->setCallback(boost::bind(&TrackedObstacleLayer::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(nh_, this, &TrackedObstacleLayer::reconfigure);
 }
 
 void TrackedObstacleLayer::reconfigure(TrackedObstacleLayerConfig& cfg, std::uint32_t) {

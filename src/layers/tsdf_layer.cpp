@@ -21,9 +21,9 @@ void TsdfLayer::onInitialize() {
   params.warnUnknown();
   param_warnings_ = params.warnings();
   if (!(std::isfinite(max_age_s_) && max_age_s_ >= 0.0)) {
-    config_errors_.push_back("parameter max_age_s = " + toText(max_age_s_) +
-                             " must be >= 0 s (0 = any age); using 0");
-    ROS_ERROR("layer '%s': %s", name_.c_str(), config_errors_.back().c_str());
+    config_errors_.setPrefix("layer '" + name_ + "'");
+    config_errors_.add("parameter max_age_s = " + toText(max_age_s_) +
+                       " must be >= 0 s (0 = any age); using 0");
     max_age_s_ = 0.0;
   }
   global_frame_ = layered_costmap_->globalFrame();
@@ -121,9 +121,10 @@ void TsdfLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("slices rejected", slices_rejected_);
   if (!last_rejection_.empty()) status.add("last rejection", last_rejection_);
   status.add("lethal cells written (last update)", lethal_written_);
-  addConfigErrors(status, config_errors_);
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  const std::vector<std::string> config_errors = config_errors_.all();
+  addConfigErrors(status, config_errors);
+  if (!config_errors.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors.front());
   } else if (!slice_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no TSDF slice received yet");
   } else if (!current_) {

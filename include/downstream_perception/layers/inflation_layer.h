@@ -2,9 +2,6 @@
 // only where the set of lethal cells changed (see core/inflation.h). Must be the last layer.
 #pragma once
 
-#include <dynamic_reconfigure/server.h>
-#include <boost/thread/recursive_mutex.hpp>
-
 #include <memory>
 #include <mutex>
 #include <string>
@@ -14,6 +11,7 @@
 #include "downstream_perception/core/costmap/inflation.h"
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
@@ -33,7 +31,6 @@ class InflationLayer : public Layer {
   void onInitialize() override;
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<InflationLayerConfig>;
   void reconfigure(InflationLayerConfig& config, std::uint32_t level);
   /// Validates `candidate` (with the footprint's inscribed radius) and rebuilds the Inflator;
   /// an invalid candidate is logged, kept under `error_key` in diagnostics (until a valid one
@@ -53,8 +50,7 @@ class InflationLayer : public Layer {
   InflationStats last_;
   std::size_t updates_ = 0;
   RunningStats update_ms_;
-  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  ReconfigureHost<InflationLayerConfig> reconfigure_;
 };
 
 }  // namespace downstream_perception

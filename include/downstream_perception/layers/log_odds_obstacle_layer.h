@@ -10,9 +10,6 @@
 // past returns.
 #pragma once
 
-#include <dynamic_reconfigure/server.h>
-#include <boost/thread/recursive_mutex.hpp>
-
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -25,6 +22,7 @@
 #include "downstream_perception/layers/track_inbox.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/param_reader.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
@@ -68,7 +66,6 @@ class LogOddsObstacleLayer : public Layer {
   void warnParam(const std::string& msg);
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<LogOddsObstacleLayerConfig>;
   void reconfigure(LogOddsObstacleLayerConfig& config, std::uint32_t level);
   void readSources(const std::string& names);
   /// Gives every source the grid's current geometry (CloudBeamsConfig::merge_grid).
@@ -109,8 +106,7 @@ class LogOddsObstacleLayer : public Layer {
   mutable std::mutex param_warnings_mutex_;
   std::vector<std::string> param_warnings_;  ///< wrong types, unsupported and unknown keys
   ConfigErrorLog config_errors_;
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
-  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
+  ReconfigureHost<LogOddsObstacleLayerConfig> reconfigure_;
 };
 
 }  // namespace downstream_perception

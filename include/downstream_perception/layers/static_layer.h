@@ -16,12 +16,10 @@
 //    in which unknown (255) wins.
 #pragma once
 
-#include <dynamic_reconfigure/server.h>
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 
-#include <boost/thread/recursive_mutex.hpp>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -29,6 +27,7 @@
 
 #include "downstream_perception/StaticLayerConfig.h"
 #include "downstream_perception/core/costmap/static_map.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
@@ -54,8 +53,6 @@ class StaticLayer : public Layer {
   void onInitialize() override;
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<StaticLayerConfig>;
-
   void readParameters();
   void subscribe();
   void onMap(const nav_msgs::OccupancyGridConstPtr& msg);
@@ -97,8 +94,7 @@ class StaticLayer : public Layer {
   ros::Subscriber update_sub_;
   ros::WallTimer wait_timer_;
   ros::WallTime subscribed_at_;
-  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  ReconfigureHost<StaticLayerConfig> reconfigure_;
 };
 
 }  // namespace downstream_perception

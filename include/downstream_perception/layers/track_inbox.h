@@ -19,6 +19,7 @@
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/core/tracking/predicted_footprint.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/rejection_counter.h"
 
 namespace downstream_perception {
 
@@ -66,7 +67,8 @@ class TrackInbox {
 
  private:
   void onTracks(const TrackedObjectArrayConstPtr& msg);
-  void reject(const std::string& reason, const std::string& detail);
+  /// "layer '<owner>' (<topic>)": the rejections' WARN prefix.
+  void setLogPrefix(const std::string& topic);
 
   std::string owner_;
   tf2_ros::Buffer* tf_ = nullptr;
@@ -79,8 +81,7 @@ class TrackInbox {
   std::size_t arrays_received_ = 0;
   std::size_t arrays_expired_ = 0;
   std::size_t tracks_skipped_state_ = 0;
-  std::map<std::string, std::size_t> rejected_;
-  std::string last_rejection_;
+  RejectionCounter rejected_;
   RunningStats transform_age_s_;  ///< now - stamp when an array is transformed
 };
 

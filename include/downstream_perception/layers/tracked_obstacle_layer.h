@@ -7,9 +7,6 @@
 // stamp over (now - stamp) + prediction_horizon_s (core/tracking/predicted_footprint.h).
 #pragma once
 
-#include <dynamic_reconfigure/server.h>
-#include <boost/thread/recursive_mutex.hpp>
-
 #include <memory>
 #include <mutex>
 #include <string>
@@ -19,6 +16,7 @@
 #include "downstream_perception/core/tracking/predicted_footprint.h"
 #include "downstream_perception/layers/track_inbox.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
@@ -42,7 +40,6 @@ class TrackedObstacleLayer : public Layer {
   void onInitialize() override;
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<TrackedObstacleLayerConfig>;
   void reconfigure(TrackedObstacleLayerConfig& config, std::uint32_t level);
 
   TrackInbox inbox_;
@@ -54,8 +51,7 @@ class TrackedObstacleLayer : public Layer {
   bool subscribed_ = false;
   ConfigErrorLog config_errors_;
   std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
-  boost::recursive_mutex reconfigure_mutex_;
+  ReconfigureHost<TrackedObstacleLayerConfig> reconfigure_;
 };
 
 }  // namespace downstream_perception

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
@@ -41,7 +42,7 @@ class TsdfLayer : public Layer {
   std::size_t slices_rejected_ = 0;
   std::string last_rejection_;
   std::size_t lethal_written_ = 0;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_;
   std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)
 };
 

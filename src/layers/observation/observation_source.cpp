@@ -27,6 +27,9 @@ void ObservationSource::countReceived() {
 }
 
 void ObservationSource::markSubscribed() {
+  // Here, not in the constructor: dataType() is the subclass's.
+  rejected_.setLogPrefix("obstacle source '" + name_ + "' (" + config_.topic + "): " + dataType() +
+                         " rejected");
   std::lock_guard<std::mutex> lock(mutex_);
   subscribed_since_ = ros::WallTime::now();
 }
@@ -34,15 +37,6 @@ void ObservationSource::markSubscribed() {
 void ObservationSource::markUnsubscribed() {
   std::lock_guard<std::mutex> lock(mutex_);
   subscribed_since_ = ros::WallTime();
-}
-
-void ObservationSource::reject(const std::string& reason, const std::string& detail) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++health_.rejected[reason];
-  }
-  ROS_WARN_THROTTLE(2.0, "obstacle source '%s' (%s): %s rejected: %s: %s", name_.c_str(),
-                    config_.topic.c_str(), dataType(), reason.c_str(), detail.c_str());
 }
 
 void ObservationSource::note(const std::string& what) {

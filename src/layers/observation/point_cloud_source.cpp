@@ -1,5 +1,6 @@
 #include "downstream_perception/layers/observation/point_cloud_source.h"
 
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 
 #include <sensor_msgs/point_cloud_conversion.h>
@@ -64,12 +65,7 @@ void PointCloudSource::onCloud(const sensor_msgs::PointCloud2& msg) {
   }
   geometry_msgs::TransformStamped t;
   if (!lookup(frameOf(msg.header.frame_id), msg.header.stamp, &t)) return;
-  const auto& q = t.transform.rotation;
-  const auto& p = t.transform.translation;
-  Eigen::Isometry3d grid_from_sensor = Eigen::Isometry3d::Identity();
-  grid_from_sensor.linear() =
-      Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
-  grid_from_sensor.translation() = Eigen::Vector3d(p.x, p.y, p.z);
+  const Eigen::Isometry3d grid_from_sensor = toEigen(t.transform);
 
   Observation obs;
   obs.stamp = msg.header.stamp;

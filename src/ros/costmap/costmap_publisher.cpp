@@ -1,6 +1,6 @@
 #include "downstream_perception/ros/costmap/costmap_publisher.h"
 
-#include "downstream_perception/ros/common/map_meta_data.h"
+#include "downstream_perception/ros/common/conversions.h"
 
 namespace downstream_perception {
 

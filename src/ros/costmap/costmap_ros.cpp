@@ -45,9 +45,7 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
       nh_.createSteadyTimer(ros::WallDuration(kClockWatchPeriodS), &CostmapRos::watchClock, this);
   // Last: its first callback applies the YAML values again (a no-op) and from then on every
   // live change goes through reconfigure().
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback(boost::bind(&CostmapRos::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(pnh_, this, &CostmapRos::reconfigure);
   ROS_INFO(
       "costmap: %d x %d cells at %.3f m in '%s', origin (%.2f, %.2f)%s, %zu layer(s), "
       "update %.1f Hz, publish %.1f Hz",
@@ -57,24 +55,24 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 CostmapRos::~CostmapRos() {
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   update_timer_.stop();
   clock_watch_.stop();
   // Layers hold subscriptions that call back into them: drop them before the loader goes.
   layered_costmap_.reset();
 }
 
-void CostmapRos::setErrors(const ConfigErrors& errors, const std::vector<std::string>& keys) {
+void CostmapRos::setErrors(const ConfigErrorLog& errors, const std::vector<std::string>& keys) {
   std::lock_guard<std::mutex> lock(errors_mutex_);
-  for (const auto& key : keys) config_errors_.eraseWithPrefix(key);
+  for (const auto& key : keys) config_errors_.clearWithPrefix(key);
   config_errors_.merge(errors);
 }
 
 void CostmapRos::applyFootprint() {
   std::vector<std::string> errors;
   layered_costmap_->setFootprint(readFootprint(pnh_, &errors));
-  ConfigErrors by_key;
-  for (std::size_t k = 0; k < errors.size(); ++k) by_key.set("footprint " + toText(k), errors[k]);
+  ConfigErrorLog by_key;
+  for (std::size_t k = 0; k < errors.size(); ++k) by_key.keep("footprint " + toText(k), errors[k]);
   setErrors(by_key, {"footprint "});
   // Latched, in the robot frame, stamp 0: the shape holds at every time, so rviz draws it
   // wherever the robot is now (a start-up stamp would predate the robot's first tf). Sent again
@@ -109,7 +107,7 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
     next.origin_y = cfg.origin_y;
   }
   next.always_send_full_costmap = cfg.always_send_full_costmap;
-  ConfigErrors errors;
+  ConfigErrorLog errors;
   validateCostmapConfig(&next, config_, &errors);
   setErrors(errors, {"update_frequency", "publish_frequency", "transform_tolerance",
                      "width/height/resolution/origin"});
@@ -151,7 +149,7 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
   if (publisher_) publisher_->setAlwaysSendFull(next.always_send_full_costmap);
   config_ = next;
   // The footprint's limits (readFootprint's): a refused value is reverted in the server.
-  ConfigErrors footprint_errors;
+  ConfigErrorLog footprint_errors("costmap");  // set() logs each
   if (!std::isfinite(cfg.robot_radius) || cfg.robot_radius < 0.0 || cfg.robot_radius > 100.0) {
     footprint_errors.set("robot_radius", "parameter ~robot_radius = " + toText(cfg.robot_radius) +
                                              " is invalid (0..100 m); keeping the previous value");
@@ -164,7 +162,6 @@ void CostmapRos::reconfigure(CostmapConfig& cfg, std::uint32_t) {
                              " is invalid (0..10 m); keeping the previous value");
     pnh_.param("footprint_padding", cfg.footprint_padding, 0.01);
   }
-  for (const auto& msg : footprint_errors.messages()) ROS_ERROR("costmap: %s", msg.c_str());
   setErrors(footprint_errors, {"robot_radius", "footprint_padding"});
   // The footprint parameters are read back from the parameter server, so set them first.
   double radius = 0.0;
@@ -204,8 +201,8 @@ void CostmapRos::loadPlugins() {
       ROS_ERROR("costmap: %s", errors.back().c_str());
     }
   }
-  ConfigErrors by_key;
-  for (std::size_t k = 0; k < errors.size(); ++k) by_key.set("plugins " + toText(k), errors[k]);
+  ConfigErrorLog by_key;
+  for (std::size_t k = 0; k < errors.size(); ++k) by_key.keep("plugins " + toText(k), errors[k]);
   setErrors(by_key, {});
 }
 
@@ -310,7 +307,7 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   std::vector<std::string> errors;
   {
     std::lock_guard<std::mutex> lock(errors_mutex_);
-    errors = config_errors_.messages();
+    errors = config_errors_.all();
   }
   std::string stale;
   for (const auto& layer : layered_costmap_->plugins()) {

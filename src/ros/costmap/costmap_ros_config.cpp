@@ -24,7 +24,7 @@ int CostmapRosConfig::sizeYCells() const {
   return cells(height, resolution);
 }
 
-CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrors* errors) {
+CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrorLog* errors) {
   CostmapRosConfig c;
   params.get("global_frame", &c.global_frame);
   params.get("robot_base_frame", &c.robot_base_frame);
@@ -61,16 +61,16 @@ const std::vector<std::string>& costmapConfigKeys() {
 }
 
 void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback,
-                           ConfigErrors* errors) {
+                           ConfigErrorLog* errors) {
   for (const char* key : {"update_frequency", "publish_frequency", "transform_tolerance",
                           "width/height/resolution/origin"}) {
-    errors->eraseWithPrefix(key);
+    errors->clearWithPrefix(key);
   }
   const auto reject = [errors](const std::string& name, const std::string& value,
                                const std::string& used) {
     const std::string msg = "parameter ~" + name + " = " + value + " is invalid; using " + used;
     ROS_ERROR("costmap: %s", msg.c_str());
-    errors->set(name, msg);
+    errors->keep(name, msg);
   };
   if (!std::isfinite(c->update_frequency) || c->update_frequency <= 0.0 ||
       c->update_frequency > 1000.0) {

@@ -37,9 +37,7 @@ HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.add("seam", this, &HandoffRos::diagnose);
   // The server reads the YAML values (or the .cfg defaults, equal to SeamLimits') and calls
   // reconfigure() at once: one code path for start-up and live changes.
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback(boost::bind(&HandoffRos::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(pnh_, this, &HandoffRos::reconfigure);
   timer_ = nh_.createTimer(ros::Duration(1.0 / health_rate_hz_), &HandoffRos::onTimer, this);
   ROS_INFO("handoff: planning in '%s', goals to '%s', %zu scan, %zu cloud and %zu track inputs%s",
            planning_frame_.c_str(), robot_base_frame_.c_str(), topics.scans.size(),

@@ -2,9 +2,9 @@
 
 #include <tf2_sensor_msgs/tf2_sensor_msgs.h>
 
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/common/tf_failure.h"
-#include "downstream_perception/ros/common/track_transform.h"
 
 namespace downstream_perception {
 
@@ -40,6 +40,8 @@ PlanningFrameRelay::Input& PlanningFrameRelay::addInput(const std::string& topic
   inputs_.push_back(std::make_unique<Input>());
   inputs_.back()->topic = ros::names::resolve(nh_.getNamespace(), topic);
   inputs_.back()->type = type;
+  inputs_.back()->rejected.setLogPrefix("handoff: " + type + " on " + inputs_.back()->topic +
+                                        " rejected");
   return *inputs_.back();
 }
 
@@ -61,21 +63,12 @@ void PlanningFrameRelay::watch(
 bool PlanningFrameRelay::arrive(Input* input, const ros::Time& stamp) {
   if (stamp.isZero()) {
     // tf reads stamp 0 as "latest": placing it would be exactly the smear this node reports.
-    reject(input, "zero stamp: a measurement must carry its time");
+    input->rejected.reject("malformed", "zero stamp: a measurement must carry its time");
     return false;
   }
   std::lock_guard<std::mutex> lock(mutex_);
   input->ages.add((ros::Time::now() - stamp).toSec());
   return true;
-}
-
-void PlanningFrameRelay::reject(Input* input, const std::string& reason) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++input->rejected;
-  }
-  ROS_WARN_THROTTLE(2.0, "handoff: %s on %s rejected: %s", input->type.c_str(),
-                    input->topic.c_str(), reason.c_str());
 }
 
 void PlanningFrameRelay::onTfFailure(Input* input, const std::string& frame, const ros::Time& stamp,
@@ -93,7 +86,7 @@ void PlanningFrameRelay::onScan(Input* input, const sensor_msgs::LaserScanConstP
   if (!arrive(input, msg->header.stamp)) return;
   const std::string why = checkScan(*msg);
   if (!why.empty()) {
-    reject(input, why);
+    input->rejected.reject("malformed", why);
     return;
   }
   // The stamp is the first beam's time; the last beam's transform is awaited too from now on.
@@ -123,7 +116,7 @@ void PlanningFrameRelay::onCloud(Input* input, const sensor_msgs::PointCloud2Con
   if (!arrive(input, msg->header.stamp)) return;
   const std::string why = checkCloudLayout(*msg);
   if (!why.empty()) {
-    reject(input, why);
+    input->rejected.reject("malformed", why);
     return;
   }
   if (!republish_) return;
@@ -182,7 +175,7 @@ std::vector<SeamInput> PlanningFrameRelay::inputs() const {
     in.type = input->type;
     in.messages = input->ages.total();
     in.tf_failures = input->tf_failures;
-    in.rejected = input->rejected;
+    in.rejected = input->rejected.total();
     in.transform_age_p50_s = input->ages.percentile(0.5);
     in.transform_age_p95_s = input->ages.percentile(0.95);
     in.transform_age_max_s = input->ages.percentile(1.0);

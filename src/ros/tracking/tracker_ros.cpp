@@ -1,9 +1,5 @@
 #include "downstream_perception/ros/tracking/tracker_ros.h"
 
-#include <tf2/LinearMath/Matrix3x3.h>
-#include <tf2/LinearMath/Quaternion.h>
-#include <tf2/LinearMath/Transform.h>
-
 #include <Eigen/Core>
 
 #include <chrono>
@@ -12,6 +8,7 @@
 
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/tf_failure.h"
 
 namespace downstream_perception {
@@ -22,17 +19,14 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   std::string mode;
   pnh_.param("mode", mode, std::string("metric"));
   if (mode != "metric" && mode != "image") {
-    const std::string msg = "parameter ~mode = '" + mode + "' is invalid; using 'metric'";
-    ROS_ERROR("tracker: %s", msg.c_str());
-    config_errors_.push_back(msg);
+    config_errors_.add("parameter ~mode = '" + mode + "' is invalid; using 'metric'");
     mode = "metric";
   }
   image_mode_ = mode == "image";
   int tf_queue_size = 20;
   pnh_.param("tf_queue_size", tf_queue_size, 20);
   if (tf_queue_size < 1 || tf_queue_size > 10000) {
-    config_errors_.push_back("parameter ~tf_queue_size must be in [1, 10000]; using 20");
-    ROS_ERROR("tracker: %s", config_errors_.back().c_str());
+    config_errors_.add("parameter ~tf_queue_size must be in [1, 10000]; using 20");
     tf_queue_size = 20;
   }
   TrackerConfig config;
@@ -46,9 +40,7 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   // The server reads the YAML values (or the .cfg defaults, equal to TrackerConfig's) and calls
   // reconfigure() at once: one code path for start-up and live changes.
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback(boost::bind(&TrackerRos::reconfigure, this,
-                                               boost::placeholders::_1, boost::placeholders::_2));
+  reconfigure_.start(pnh_, this, &TrackerRos::reconfigure);
 
   if (image_mode_) {
     // Image boxes stay in their camera frame: no transform.
@@ -93,7 +85,7 @@ void TrackerRos::watchClock(const ros::SteadyTimerEvent&) {
 
 TrackerRos::~TrackerRos() {
   clock_watch_.stop();
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   filtered_.unsubscribe();
   subscriber_.reset();
 }
@@ -117,18 +109,8 @@ void TrackerRos::reconfigure(TrackerNodeConfig& c, std::uint32_t) {
   try {
     tracker_->setConfig(next);
   } catch (const std::invalid_argument& e) {
-    const std::string msg = std::string(e.what()) + "; keeping the previous settings";
-    ROS_ERROR("%s", msg.c_str());
-    config_errors_.push_back(msg);
+    config_errors_.add(std::string(e.what()) + "; keeping the previous settings");
   }
-}
-
-void TrackerRos::reject(const std::string& reason, const std::string& detail) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++rejected_[reason];
-  }
-  ROS_WARN_THROTTLE(2.0, "tracker: detections rejected: %s: %s", reason.c_str(), detail.c_str());
 }
 
 void TrackerRos::onTfFailure(const DetectedObjectArrayConstPtr& msg,
@@ -136,27 +118,24 @@ void TrackerRos::onTfFailure(const DetectedObjectArrayConstPtr& msg,
   std::ostringstream detail;
   detail << "frame '" << msg->header.frame_id << "' -> '" << tracking_frame_ << "' at stamp "
          << msg->header.stamp;
-  reject(tfFailureReason(reason), detail.str());
+  rejected_.reject(tfFailureReason(reason), detail.str());
 }
 
 bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* out,
                         std::string* why) {
-  tf2::Transform to_tracking;
-  to_tracking.setIdentity();
+  Eigen::Isometry3d to_tracking = Eigen::Isometry3d::Identity();
   if (!image_mode_) {
     try {
-      const auto t =
-          tf_buffer_->lookupTransform(tracking_frame_, msg.header.frame_id, msg.header.stamp);
-      const auto& q = t.transform.rotation;
-      const auto& p = t.transform.translation;
-      to_tracking =
-          tf2::Transform(tf2::Quaternion(q.x, q.y, q.z, q.w), tf2::Vector3(p.x, p.y, p.z));
+      to_tracking = toEigen(
+          tf_buffer_->lookupTransform(tracking_frame_, msg.header.frame_id, msg.header.stamp)
+              .transform);
     } catch (const tf2::TransformException& e) {
       *why = std::string("tf: lookup at stamp failed: ") + e.what();
       return false;
     }
   }
-  const tf2::Matrix3x3& r = to_tracking.getBasis();
+  // The top-left 2 x 2 of the rotation turns the planar covariances: C' = R C R^T.
+  const Eigen::Matrix2d rot = to_tracking.linear().topLeftCorner<2, 2>();
   for (const auto& d : msg.detections) {
     if (d.kind != DetectedObject::BOX && d.kind != DetectedObject::POSITION) {
       ++detections_unknown_kind_;  // neither a box nor a position: nothing to read
@@ -176,18 +155,15 @@ bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* 
       }
       c.box = {d.x_min, d.y_min, d.x_max, d.y_max};
     } else {
-      const tf2::Vector3 p = to_tracking * tf2::Vector3(d.position.x, d.position.y, d.position.z);
+      const Eigen::Vector3d p =
+          to_tracking * Eigen::Vector3d(d.position.x, d.position.y, d.position.z);
       c.x = p.x();
       c.y = p.y();
-      // Rotate the planar covariance: C' = R C R^T (the top-left 2 x 2 of the rotation).
-      Eigen::Matrix2d rot, cov;
-      rot << r[0][0], r[0][1], r[1][0], r[1][1];
-      cov << d.position_covariance[0], d.position_covariance[1], d.position_covariance[2],
-          d.position_covariance[3];
-      const Eigen::Matrix2d rotated = rot * cov * rot.transpose();
-      c.cov_xx = rotated(0, 0);
-      c.cov_xy = 0.5 * (rotated(0, 1) + rotated(1, 0));
-      c.cov_yy = rotated(1, 1);
+      boost::array<double, 4> cov = d.position_covariance;
+      rotateCovariance(rot, &cov);
+      c.cov_xx = cov[0];
+      c.cov_xy = 0.5 * (cov[1] + cov[2]);
+      c.cov_yy = cov[3];
       c.size_x = d.size_x;
       c.size_y = d.size_y;
     }
@@ -198,7 +174,7 @@ bool TrackerRos::toCore(const DetectedObjectArray& msg, std::vector<Detection>* 
 
 void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
-    reject("bad message: zero stamp", "detections must carry their measurement time");
+    rejected_.reject("bad message: zero stamp", "detections must carry their measurement time");
     return;
   }
   {
@@ -206,7 +182,7 @@ void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
     std::vector<Detection> detections;
     std::string why;
     if (!toCore(*msg, &detections, &why)) {
-      ++rejected_["tf: lookup at stamp failed"];
+      rejected_.count("tf: lookup at stamp failed");
       ROS_WARN_THROTTLE(2.0, "tracker: %s", why.c_str());
       return;
     }
@@ -214,7 +190,7 @@ void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
     try {
       last_ = tracker_->step(msg->header.stamp.toSec(), detections);
     } catch (const std::invalid_argument& e) {
-      ++rejected_["bad message: stamp older than the previous frame"];
+      rejected_.count("bad message: stamp older than the previous frame");
       ROS_WARN_THROTTLE(2.0, "tracker: %s", e.what());
       return;
     }
@@ -262,11 +238,7 @@ void TrackerRos::publish(const std_msgs::Header& header) {
 
 void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::size_t rejected = 0;
-  for (const auto& [reason, count] : rejected_) {
-    status.add("rejected (" + reason + ")", count);
-    rejected += count;
-  }
+  const std::size_t rejected = rejected_.report(status);
   status.add("frames", frames_);
   status.add("clock jumps back (tracks reset)", clock_jump_.jumps());
   status.add("tracks alive", last_.tracks);
@@ -285,10 +257,11 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("ID switches vs truth ids (total)", total_.id_switches);
   status.add("step time mean (us)", step_us_.mean());
   status.add("step time max (us)", step_us_.max);
-  addConfigErrors(status, config_errors_);
+  const std::vector<std::string> config_errors = config_errors_.all();
+  addConfigErrors(status, config_errors);
   const std::size_t waiting = addTfWaits(status, "", filtered_.waitingForTf());
-  if (!config_errors_.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors_.front());
+  if (!config_errors.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, config_errors.front());
   } else if (waiting > 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    std::to_string(waiting) + " message(s) waiting for tf (see 'waiting for tf')");

@@ -1,5 +1,8 @@
 #include "downstream_perception/ros/tsdf/tsdf_params.h"
 
+#include <cmath>
+#include <cstddef>
+
 namespace downstream_perception {
 
 std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c) {
@@ -38,6 +41,73 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   if (why.empty()) return c;
   errors->add("invalid TSDF parameters (" + why + "); using the defaults");
   return TsdfConfig{};
+}
+
+TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
+  TsdfNodeSettings s;
+  pnh.param("mesh_rate_hz", s.mesh_rate_hz, s.mesh_rate_hz);
+  if (!(std::isfinite(s.mesh_rate_hz) && s.mesh_rate_hz > 0.0 && s.mesh_rate_hz <= 100.0)) {
+    errors->add("parameter ~mesh_rate_hz = " + toText(s.mesh_rate_hz) +
+                " must be in (0, 100] Hz; using 1");
+    s.mesh_rate_hz = 1.0;
+  }
+  pnh.param("health_period_s", s.health_period_s, s.health_period_s);
+  if (!(std::isfinite(s.health_period_s) && s.health_period_s >= 0.0)) {
+    errors->add("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
+    s.health_period_s = 10.0;
+  }
+  pnh.param("slice_min_z_m", s.slice.min_z_m, s.slice.min_z_m);
+  pnh.param("slice_max_z_m", s.slice.max_z_m, s.slice.max_z_m);
+  const std::string slice_why = s.slice.validate();
+  if (!slice_why.empty()) {
+    errors->add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
+    s.slice = TsdfSliceConfig{};
+  }
+  pnh.param("slice_distance_max_m", s.slice_distance_max_m, s.slice_distance_max_m);
+  if (!(std::isfinite(s.slice_distance_max_m) && s.slice_distance_max_m >= 0.0 &&
+        s.slice_distance_max_m <= 100.0)) {
+    errors->add("parameter ~slice_distance_max_m = " + toText(s.slice_distance_max_m) +
+                " must be in [0, 100] m (0 = off); using 2");
+    s.slice_distance_max_m = 2.0;
+  }
+  pnh.param("tf_queue_size", s.tf_queue_size, s.tf_queue_size);
+  if (s.tf_queue_size < 1 || s.tf_queue_size > 1000) {
+    errors->add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
+    s.tf_queue_size = 10;
+  }
+  return s;
+}
+
+OctomapSettings readOctomapSettings(const ros::NodeHandle& pnh, const TsdfConfig& map,
+                                    ConfigErrorLog* errors) {
+  OctomapSettings s;
+  OctreeConfig& octree = s.octree;
+  pnh.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
+  pnh.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
+  octree.max_range_m = map.max_depth_m;
+  octree.max_distance_m = map.max_block_distance_m;  // the TSDF's bound
+  double max_memory_mb = static_cast<double>(octree.max_memory_bytes) / (1 << 20);
+  pnh.param("octomap_max_memory_mb", max_memory_mb, max_memory_mb);
+  if (!(std::isfinite(max_memory_mb) && max_memory_mb >= 1.0 && max_memory_mb <= 1e6)) {
+    errors->add("parameter ~octomap_max_memory_mb = " + toText(max_memory_mb) +
+                " must be in [1, 1e6] MiB; using 256");
+    max_memory_mb = 256.0;
+  }
+  octree.max_memory_bytes = static_cast<std::size_t>(max_memory_mb * (1 << 20));
+  pnh.param("octomap_queue_size", s.queue_size, s.queue_size);
+  if (s.queue_size < 1 || s.queue_size > 100) {
+    errors->add("parameter ~octomap_queue_size must be in [1, 100]; using 2");
+    s.queue_size = 2;
+  }
+  if (s.enabled()) {
+    const std::string why = octree.validate();
+    if (!why.empty()) {
+      errors->add("OctoMap parameters invalid (" + why + "); using the defaults");
+      octree = OctreeConfig{};
+      octree.max_distance_m = map.max_block_distance_m;
+    }
+  }
+  return s;
 }
 
 }  // namespace downstream_perception

@@ -12,6 +12,7 @@
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/common/save_service.h"
 #include "downstream_perception/ros/common/tf_failure.h"
@@ -19,19 +20,6 @@
 #include "downstream_perception/ros/tsdf/tsdf_slice_messages.h"
 
 namespace downstream_perception {
-
-namespace {
-
-Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
-  return T;
-}
-
-}  // namespace
 
 template <class M>
 void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
@@ -43,7 +31,7 @@ void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
         std::ostringstream detail;
         detail << what << " in '" << m->header.frame_id << "' at stamp " << m->header.stamp;
-        reject(tfFailureReason(reason), detail.str());
+        rejected_.reject(tfFailureReason(reason), detail.str());
       });
 }
 
@@ -52,69 +40,16 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   config_errors_.setPrefix("tsdf");
   pnh_.param("world_frame", world_frame_, std::string("odom"));
   output_directory_ = readOutputDirectory(pnh_, &config_errors_);
-  double mesh_rate_hz = 1.0;
-  pnh_.param("mesh_rate_hz", mesh_rate_hz, mesh_rate_hz);
-  if (!(std::isfinite(mesh_rate_hz) && mesh_rate_hz > 0.0 && mesh_rate_hz <= 100.0)) {
-    config_errors_.add("parameter ~mesh_rate_hz = " + toText(mesh_rate_hz) +
-                       " must be in (0, 100] Hz; using 1");
-    mesh_rate_hz = 1.0;
-  }
-  pnh_.param("health_period_s", health_period_s_, health_period_s_);
-  if (!(std::isfinite(health_period_s_) && health_period_s_ >= 0.0)) {
-    config_errors_.add("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
-    health_period_s_ = 10.0;
-  }
-  pnh_.param("slice_min_z_m", slice_.min_z_m, slice_.min_z_m);
-  pnh_.param("slice_max_z_m", slice_.max_z_m, slice_.max_z_m);
-  const std::string slice_why = slice_.validate();
-  if (!slice_why.empty()) {
-    config_errors_.add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
-    slice_ = TsdfSliceConfig{};
-  }
-  pnh_.param("slice_distance_max_m", slice_distance_max_m_, slice_distance_max_m_);
-  if (!(std::isfinite(slice_distance_max_m_) && slice_distance_max_m_ >= 0.0 &&
-        slice_distance_max_m_ <= 100.0)) {
-    config_errors_.add("parameter ~slice_distance_max_m = " + toText(slice_distance_max_m_) +
-                       " must be in [0, 100] m (0 = off); using 2");
-    slice_distance_max_m_ = 2.0;
-  }
-  int tf_queue_size = 10;
-  pnh_.param("tf_queue_size", tf_queue_size, tf_queue_size);
-  if (tf_queue_size < 1 || tf_queue_size > 1000) {
-    config_errors_.add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
-    tf_queue_size = 10;
-  }
+  const TsdfNodeSettings settings = readTsdfNodeSettings(pnh_, &config_errors_);
+  health_period_s_ = settings.health_period_s;
+  slice_ = settings.slice;
+  slice_distance_max_m_ = settings.slice_distance_max_m;
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
-  OctreeConfig octree;
-  pnh_.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
-  pnh_.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
-  octree.max_range_m = map_->config().max_depth_m;
-  octree.max_distance_m = map_->config().max_block_distance_m;  // the TSDF's bound
-  double octree_max_memory_mb = static_cast<double>(octree.max_memory_bytes) / (1 << 20);
-  pnh_.param("octomap_max_memory_mb", octree_max_memory_mb, octree_max_memory_mb);
-  if (!(std::isfinite(octree_max_memory_mb) && octree_max_memory_mb >= 1.0 &&
-        octree_max_memory_mb <= 1e6)) {
-    config_errors_.add("parameter ~octomap_max_memory_mb = " + toText(octree_max_memory_mb) +
-                       " must be in [1, 1e6] MiB; using 256");
-    octree_max_memory_mb = 256.0;
-  }
-  octree.max_memory_bytes = static_cast<std::size_t>(octree_max_memory_mb * (1 << 20));
-  int octree_queue = 2;
-  pnh_.param("octomap_queue_size", octree_queue, octree_queue);
-  if (octree_queue < 1 || octree_queue > 100) {
-    config_errors_.add("parameter ~octomap_queue_size must be in [1, 100]; using 2");
-    octree_queue = 2;
-  }
-  if (octree.resolution_m > 0.0) {  // 0 turns the OctoMap off
-    const std::string why = octree.validate();
-    if (!why.empty()) {
-      config_errors_.add("OctoMap parameters invalid (" + why + "); using the defaults");
-      octree = OctreeConfig{};
-      octree.max_distance_m = map_->config().max_block_distance_m;
-    }
-    octree_max_memory_bytes_ = octree.max_memory_bytes;
-    octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octree),
-                                             static_cast<std::size_t>(octree_queue));
+  const OctomapSettings octomap = readOctomapSettings(pnh_, map_->config(), &config_errors_);
+  if (octomap.enabled()) {  // ~octomap_resolution_m = 0 turns the OctoMap off
+    octree_max_memory_bytes_ = octomap.octree.max_memory_bytes;
+    octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octomap.octree),
+                                             static_cast<std::size_t>(octomap.queue_size));
   }
 
   mesh_publisher_ = pnh_.advertise<visualization_msgs::MarkerArray>("mesh", 2);
@@ -137,14 +72,13 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   // Raw subscribers check each message first (a wrong encoding is reported at once instead of
   // waiting for tf) and pass it to a tf2 MessageFilter, which holds it until the transform to
   // the world frame at its stamp exists.
-  attachTfFilter(&depth_filter_, &TsdfRos::onDepth, "depth image", tf_queue_size);
+  attachTfFilter(&depth_filter_, &TsdfRos::onDepth, "depth image", settings.tf_queue_size);
   depth_subscriber_ = nh_.subscribe("depth/image", 5, &TsdfRos::onDepthRaw, this);
-  attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", tf_queue_size);
+  attachTfFilter(&cloud_filter_, &TsdfRos::onCloud, "point cloud", settings.tf_queue_size);
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
-  mesh_timer_ = pnh_.createTimer(ros::Duration(1.0 / mesh_rate_hz), &TsdfRos::publishMesh, this);
-  reconfigure_server_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback(
-      boost::bind(&TsdfRos::reconfigure, this, boost::placeholders::_1, boost::placeholders::_2));
+  mesh_timer_ =
+      pnh_.createTimer(ros::Duration(1.0 / settings.mesh_rate_hz), &TsdfRos::publishMesh, this);
+  reconfigure_.start(pnh_, this, &TsdfRos::reconfigure);
   const TsdfConfig& c = map_->config();
   ROS_INFO(
       "tsdf: %.3f m voxels, truncation %.3f m, in '%s'; depth on %s, clouds on %s; files saved "
@@ -156,7 +90,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 TsdfRos::~TsdfRos() {
-  reconfigure_server_.reset();
+  reconfigure_.stop();
   mesh_timer_.stop();
   depth_subscriber_.shutdown();
   cloud_subscriber_.shutdown();
@@ -216,14 +150,6 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
            now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m);
 }
 
-void TsdfRos::reject(const std::string& reason, const std::string& detail) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++rejected_[reason];
-  }
-  ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s: %s", reason.c_str(), detail.c_str());
-}
-
 bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::string* why) {
   try {
     *T =
@@ -242,7 +168,7 @@ void TsdfRos::onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
 
 void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
   if (stats.refused != nullptr) {  // counted as rejected, like the node's own checks
-    ++rejected_[std::string("integrator: ") + stats.refused];
+    rejected_.count(std::string("integrator: ") + stats.refused);
     ROS_WARN_THROTTLE(2.0, "tsdf: frame rejected: %s", stats.refused);
     return;
   }
@@ -277,15 +203,15 @@ bool TsdfRos::cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, 
 
 void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
-    reject("bad message: zero stamp", "depth images must carry their measurement time");
+    rejected_.reject("bad message: zero stamp", "depth images must carry their measurement time");
     return;
   }
   std::string why;
   PinholeCamera camera;
   if (!checkDepthImage(*msg, &why)) {  // converted once, after tf, in onDepth()
-    reject("bad depth image", why);
+    rejected_.reject("bad depth image", why);
   } else if (!cameraFor(*msg, &camera, &why)) {
-    reject("camera_info missing or inconsistent", why);
+    rejected_.reject("camera_info missing or inconsistent", why);
   } else {
     depth_filter_.add(msg);
   }
@@ -298,11 +224,11 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
   Eigen::Isometry3d T_world_camera;
   // Checked on arrival already; the CameraInfo may have changed while waiting for tf.
   if (!depthImageToMetres(*msg, &metres, &why) || !cameraFor(*msg, &camera, &why)) {
-    reject("camera_info missing or inconsistent", why);
+    rejected_.reject("camera_info missing or inconsistent", why);
     return;
   }
   if (!lookup(msg->header, &T_world_camera, &why)) {
-    reject("tf: lookup at stamp failed", why);
+    rejected_.reject("tf: lookup at stamp failed", why);
     return;
   }
   {
@@ -321,12 +247,12 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
 
 void TsdfRos::onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg) {
   if (msg->header.stamp.isZero()) {
-    reject("bad message: zero stamp", "point clouds must carry their measurement time");
+    rejected_.reject("bad message: zero stamp", "point clouds must carry their measurement time");
     return;
   }
   const std::string why = checkCloudLayout(*msg);  // the layout every cloud consumer checks
   if (!why.empty()) {
-    reject("bad point cloud", why);
+    rejected_.reject("bad point cloud", why);
     return;
   }
   cloud_filter_.add(msg);
@@ -336,7 +262,7 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   Eigen::Isometry3d T_world_sensor;
   std::string why;
   if (!lookup(msg->header, &T_world_sensor, &why)) {
-    reject("tf: lookup at stamp failed", why);
+    rejected_.reject("tf: lookup at stamp failed", why);
     return;
   }
   std::size_t x_offset = 0;
@@ -488,11 +414,7 @@ bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
 
 void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::size_t rejected = 0;
-  for (const auto& [reason, count] : rejected_) {
-    status.add("rejected (" + reason + ")", count);
-    rejected += count;
-  }
+  const std::size_t rejected = rejected_.report(status);
   status.add("frames integrated", frames_integrated_);
   status.add("frames rejected", rejected);
   status.add("integration time mean (ms)", integrate_ms_.mean());

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "downstream_perception/ros/common/map_meta_data.h"
+#include "downstream_perception/ros/common/conversions.h"
 
 namespace downstream_perception {
 

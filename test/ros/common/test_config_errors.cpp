@@ -50,5 +50,28 @@ TEST(ConfigErrorLog, LastingErrorsStayAndComeFirst) {
   EXPECT_EQ(summaryOf(log, &any), "source 'x': data_type 'Foo' is not supported");
 }
 
+// The costmap host's use (formerly its own ConfigErrors): a group of numbered keys read again as
+// a whole replaces the old group, problems found into a scratch log are merged in by key.
+TEST(ConfigErrorLog, PrefixClearAndMergeKeepTheOrderOfFirstAppearance) {
+  ConfigErrorLog log("costmap");
+  log.keep("footprint 0", "point 0 is not finite");
+  log.keep("update_frequency", "update_frequency -1 is invalid");
+  log.keep("footprint 1", "point 1 is not finite");
+  EXPECT_FALSE(log.empty());
+
+  ConfigErrorLog scratch("costmap");
+  scratch.keep("footprint 0", "fewer than 3 points");
+  scratch.keep("update_frequency", "update_frequency 0 is invalid");
+  log.clearWithPrefix("footprint ");
+  EXPECT_EQ(log.all(), (std::vector<std::string>{"update_frequency -1 is invalid"}));
+  log.merge(scratch);
+  // update_frequency keeps its place (replaced in place); the new footprint entry comes after.
+  EXPECT_EQ(log.all(),
+            (std::vector<std::string>{"update_frequency 0 is invalid", "fewer than 3 points"}));
+  log.clearWithPrefix("update_frequency");
+  log.clearWithPrefix("footprint ");
+  EXPECT_TRUE(log.empty());
+}
+
 }  // namespace
 }  // namespace downstream_perception

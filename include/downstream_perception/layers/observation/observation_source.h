@@ -25,6 +25,7 @@
 #include "downstream_perception/core/costmap/scan_integrator.h"
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/rejection_counter.h"
 
 namespace downstream_perception {
 
@@ -72,9 +73,8 @@ class ObservationSource {
   struct Health {
     std::size_t received = 0;
     std::size_t integrated = 0;
-    std::map<std::string, std::size_t> rejected;  ///< reason -> count (bad message, tf, ...)
-    std::map<std::string, std::size_t> notes;     ///< accepted, but e.g. de-skew skipped
-    RunningStats transform_age_s;                 ///< now - stamp when integrated
+    std::map<std::string, std::size_t> notes;  ///< accepted, but e.g. de-skew skipped
+    RunningStats transform_age_s;              ///< now - stamp when integrated
     RunningStats integrate_ms;
     IntegrationStats last;   ///< the last message's integration
     IntegrationStats total;  ///< since start
@@ -82,6 +82,8 @@ class ObservationSource {
     ros::WallTime last_integrated;
   };
   const Health& health() const { return health_; }
+  /// Messages refused, by reason (bad message, tf, ...); has its own lock.
+  const RejectionCounter& rejections() const { return rejected_; }
   std::mutex& mutex() { return mutex_; }
   void recordIntegration(const IntegrationStats& stats, double integrate_ms, double age_s);
   /// True if observations arrive as often as expected_update_rate demands (costmap_2d's rule:
@@ -112,7 +114,10 @@ class ObservationSource {
   /// Subscribed now: expected_update_rate and the publisher check count from here.
   void markSubscribed();
   void markUnsubscribed();
-  void reject(const std::string& reason, const std::string& detail);
+  /// Counts a refused message by reason (throttled WARN naming the source and its topic).
+  void reject(const std::string& reason, const std::string& detail) {
+    rejected_.reject(reason, detail);
+  }
   void note(const std::string& what);
   void onTfFailure(const std::string& frame, const ros::Time& stamp,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason);
@@ -135,6 +140,7 @@ class ObservationSource {
  private:
   mutable std::mutex mutex_;
   Health health_;
+  RejectionCounter rejected_;
   ros::WallTime subscribed_since_;  ///< zero while unsubscribed; guarded by mutex_
   std::atomic<double> mark_max_z_{std::numeric_limits<double>::infinity()};
   mutable std::mutex merge_grid_mutex_;

@@ -47,6 +47,9 @@ inline void addParamWarnings(diagnostic_updater::DiagnosticStatusWrapper& status
 /// clear(key) drops it: a later reconfigure that fixes the value removes the error.
 class ConfigErrorLog {
  public:
+  /// `prefix` starts each logged error ("costmap", "layer 'obstacles'").
+  explicit ConfigErrorLog(std::string prefix = "config") : prefix_(std::move(prefix)) {}
+
   void setPrefix(std::string prefix) { prefix_ = std::move(prefix); }
   void add(const std::string& msg) {
     ROS_ERROR("%s: %s", prefix_.c_str(), msg.c_str());
@@ -56,6 +59,10 @@ class ConfigErrorLog {
   /// The current problem of `key`, replacing the previous one (logged as an error).
   void set(const std::string& key, const std::string& msg) {
     ROS_ERROR("%s: %s", prefix_.c_str(), msg.c_str());
+    keep(key, msg);
+  }
+  /// As set(), for a problem the caller has logged already.
+  void keep(const std::string& key, const std::string& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto& entry : keyed_) {
       if (entry.first == key) {
@@ -74,6 +81,35 @@ class ConfigErrorLog {
         return;
       }
     }
+  }
+  /// Every key starting with `prefix` is fine now (a key is its own prefix): for a group of
+  /// numbered keys ("footprint 0", "footprint 1", ...) read again as a whole.
+  void clearWithPrefix(const std::string& prefix) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::pair<std::string, std::string>> kept;
+    for (auto& entry : keyed_) {
+      if (entry.first.rfind(prefix, 0) != 0) kept.push_back(std::move(entry));
+    }
+    keyed_ = std::move(kept);
+  }
+  /// Takes over the problems of `other` (found into a scratch log, logged there already).
+  void merge(const ConfigErrorLog& other) {
+    std::vector<std::string> lasting;
+    std::vector<std::pair<std::string, std::string>> keyed;
+    {
+      std::lock_guard<std::mutex> lock(other.mutex_);
+      lasting = other.errors_;
+      keyed = other.keyed_;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      errors_.insert(errors_.end(), lasting.begin(), lasting.end());
+    }
+    for (const auto& entry : keyed) keep(entry.first, entry.second);
+  }
+  bool empty() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return errors_.empty() && keyed_.empty();
   }
   /// Every current problem: the lasting ones first, then the keyed ones in the order they arose.
   std::vector<std::string> all() const {

@@ -4,13 +4,11 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PolygonStamped.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
-#include <boost/thread/recursive_mutex.hpp>
 #include <pluginlib/class_loader.hpp>
 
 #include <memory>
@@ -21,6 +19,7 @@
 #include "downstream_perception/CostmapConfig.h"
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/ros/common/clock_jump.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/costmap_publisher.h"
 #include "downstream_perception/ros/costmap/costmap_ros_config.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
@@ -35,7 +34,6 @@ class CostmapRos {
   LayeredCostmap& layeredCostmap() { return *layered_costmap_; }
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<CostmapConfig>;
   void loadPlugins();
   /// WARNs for host-level keys nobody reads (after the layers are loaded).
   void auditKeys(ParamReader& params);
@@ -48,13 +46,13 @@ class CostmapRos {
   void diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status);
   void applyFootprint();
   /// Replaces the entries of `keys` and adds `errors` (by key) to the config errors.
-  void setErrors(const ConfigErrors& errors, const std::vector<std::string>& keys);
+  void setErrors(const ConfigErrorLog& errors, const std::vector<std::string>& keys);
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
   CostmapRosConfig config_;
   std::mutex errors_mutex_;
-  ConfigErrors config_errors_;               ///< by key: a later valid value clears its entry
+  ConfigErrorLog config_errors_;             ///< by key: a later valid value clears its entry
   std::vector<std::string> param_warnings_;  ///< wrong types, unknown / unsupported keys (start-up)
   std::vector<std::string> layer_types_;     ///< the loaded layers' types as configured
 
@@ -68,8 +66,7 @@ class CostmapRos {
   geometry_msgs::PolygonStamped footprint_msg_;  ///< the padded footprint in robot_base_frame
   ros::ServiceServer clear_service_;
   diagnostic_updater::Updater diagnostics_;
-  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  ReconfigureHost<CostmapConfig> reconfigure_;
   bool reconfigure_started_ = false;
 
   ros::Timer update_timer_;

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/param_reader.h"
 
 namespace downstream_perception {
@@ -29,53 +30,17 @@ struct CostmapRosConfig {
   int sizeYCells() const;
 };
 
-/// Parameter problems by key, in the order they were found (the first is the diagnostics
-/// summary); a later valid value for a key clears its entry.
-class ConfigErrors {
- public:
-  /// Replaces the entry of `key` in place, or appends one.
-  void set(const std::string& key, const std::string& msg) {
-    for (auto& entry : entries_) {
-      if (entry.first == key) {
-        entry.second = msg;
-        return;
-      }
-    }
-    entries_.emplace_back(key, msg);
-  }
-  /// Erases every entry whose key starts with `prefix` (a key is its own prefix).
-  void eraseWithPrefix(const std::string& prefix) {
-    std::vector<std::pair<std::string, std::string>> kept;
-    for (auto& entry : entries_) {
-      if (entry.first.rfind(prefix, 0) != 0) kept.push_back(std::move(entry));
-    }
-    entries_ = std::move(kept);
-  }
-  void merge(const ConfigErrors& other) {
-    for (const auto& entry : other.entries_) set(entry.first, entry.second);
-  }
-  std::vector<std::string> messages() const {
-    std::vector<std::string> out;
-    for (const auto& entry : entries_) out.push_back(entry.second);
-    return out;
-  }
-  bool empty() const { return entries_.empty(); }
-
- private:
-  std::vector<std::pair<std::string, std::string>> entries_;
-};
-
 /// Reads every field through `params` (defaults for the missing ones; a value of the wrong type
 /// is named and the default used), then validates.
-CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrors* errors);
+CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrorLog* errors);
 
 /// The host-level keys readCostmapConfig() reads (for the unknown-key audit).
 const std::vector<std::string>& costmapConfigKeys();
 
 /// Replaces each invalid field of *config by the one of `fallback`, reporting each into *errors
-/// (and the log) by parameter name, value and what is used instead. Every key it checks that is
+/// (which logs it) by parameter name, value and what is used instead. Every key it checks that is
 /// valid now has its entry erased from *errors.
 void validateCostmapConfig(CostmapRosConfig* config, const CostmapRosConfig& fallback,
-                           ConfigErrors* errors);
+                           ConfigErrorLog* errors);
 
 }  // namespace downstream_perception

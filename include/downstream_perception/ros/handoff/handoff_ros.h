@@ -12,12 +12,10 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
-#include <boost/thread/recursive_mutex.hpp>
 
 #include <memory>
 #include <mutex>
@@ -29,6 +27,7 @@
 #include "downstream_perception/TransformPose.h"
 #include "downstream_perception/core/handoff/seam_health.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/handoff/planning_frame_relay.h"
 
 namespace downstream_perception {
@@ -46,7 +45,6 @@ class HandoffRos {
   HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh);
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<HandoffConfig>;
   void loadParameters();
   void reconfigure(HandoffConfig& config, std::uint32_t level);
   void onGoal(const geometry_msgs::PoseStampedConstPtr& msg);
@@ -84,8 +82,7 @@ class HandoffRos {
   ros::ServiceServer transform_service_;
   ros::Timer timer_;
   diagnostic_updater::Updater diagnostics_;
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
-  boost::recursive_mutex reconfigure_mutex_;
+  ReconfigureHost<HandoffConfig> reconfigure_;
 };
 
 }  // namespace downstream_perception

@@ -21,6 +21,7 @@
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/core/handoff/seam_health.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/rejection_counter.h"
 
 namespace downstream_perception {
 
@@ -49,8 +50,8 @@ class PlanningFrameRelay {
     FilteredSubscription<TrackedObjectArray> tracks;
     SampleWindow ages;
     std::size_t tf_failures = 0;
-    std::size_t rejected = 0;
-    ros::Duration scan_sweep;  ///< longest scan duration seen: tf is awaited to its last beam
+    RejectionCounter rejected;  ///< one reason: the diagnostics show one "malformed" count
+    ros::Duration scan_sweep;   ///< longest scan duration seen: tf is awaited to its last beam
   };
 
   Input& addInput(const std::string& topic, const std::string& type);
@@ -59,7 +60,6 @@ class PlanningFrameRelay {
              void (PlanningFrameRelay::*on_message)(Input*, const boost::shared_ptr<const M>&));
   /// Records the age; false (and counted) for a zero stamp.
   bool arrive(Input* input, const ros::Time& stamp);
-  void reject(Input* input, const std::string& reason);
   void onTfFailure(Input* input, const std::string& frame, const ros::Time& stamp,
                    const std::string& why);
   void onScan(Input* input, const sensor_msgs::LaserScanConstPtr& msg);

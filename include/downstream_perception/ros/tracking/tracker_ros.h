@@ -5,13 +5,11 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
 #include <message_filters/subscriber.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
-#include <boost/thread/recursive_mutex.hpp>
 
 #include <map>
 #include <memory>
@@ -24,7 +22,10 @@
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/core/tracking/tracker.h"
 #include "downstream_perception/ros/common/clock_jump.h"
+#include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
+#include "downstream_perception/ros/common/rejection_counter.h"
 #include "downstream_perception/ros/tracking/track_markers.h"
 
 namespace downstream_perception {
@@ -35,7 +36,6 @@ class TrackerRos {
   ~TrackerRos();
 
  private:
-  using ReconfigureServer = dynamic_reconfigure::Server<TrackerNodeConfig>;
   void reconfigure(TrackerNodeConfig& cfg, std::uint32_t level);
   void onDetections(const DetectedObjectArrayConstPtr& msg);
   void onTfFailure(const DetectedObjectArrayConstPtr& msg,
@@ -47,7 +47,6 @@ class TrackerRos {
   /// Resets the tracks and tf when the ROS clock went back; else updates the diagnostics.
   void watchClock(const ros::SteadyTimerEvent&);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  void reject(const std::string& reason, const std::string& detail);
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
@@ -65,19 +64,18 @@ class TrackerRos {
   ros::Publisher markers_publisher_;
   TrackMarkers markers_;
   diagnostic_updater::Updater diagnostics_;
-  boost::recursive_mutex reconfigure_mutex_;  // the type dynamic_reconfigure::Server takes
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
+  ReconfigureHost<TrackerNodeConfig> reconfigure_;
 
   // Diagnostics.
   TrackerStats total_;
   TrackerStats last_;
   std::size_t frames_ = 0;
-  std::map<std::string, std::size_t> rejected_;
+  RejectionCounter rejected_{"tracker: detections rejected"};
   ClockJumpDetector clock_jump_;
   std::size_t detections_unknown_kind_ = 0;
   ros::SteadyTimer clock_watch_;
   RunningStats step_us_;
-  std::vector<std::string> config_errors_;
+  ConfigErrorLog config_errors_{"tracker"};
 };
 
 }  // namespace downstream_perception

@@ -1,11 +1,15 @@
-// TsdfConfig from ROS parameters (names = TsdfConfig fields, units in the names).
+// The TSDF nodelet's parameters, read in one place: the map's TsdfConfig (names = its fields,
+// units in the names), the nodelet's own settings and the OctoMap's. Validation of the map's
+// config stays in the core (TsdfConfig::validate, OctreeConfig::validate).
 #pragma once
 
 #include <ros/node_handle.h>
 
 #include <string>
 
+#include "downstream_perception/core/tsdf/octree_worker.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/ros/common/config_errors.h"
 
 namespace downstream_perception {
@@ -19,5 +23,26 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors);
 /// block cap as an int), checked and stored into `c`. Empty on success, else the reason (and `c`
 /// keeps its values). Shared by the start-up parameters and dynamic_reconfigure.
 std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c);
+
+/// The nodelet's own settings beside the map's TsdfConfig (~mesh_rate_hz, ~health_period_s, the
+/// slice, ~tf_queue_size). Each invalid value is added to `errors` and its default used.
+struct TsdfNodeSettings {
+  double mesh_rate_hz = 1.0;
+  double health_period_s = 10.0;  ///< 0: no periodic health line
+  TsdfSliceConfig slice;
+  double slice_distance_max_m = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
+  int tf_queue_size = 10;
+};
+TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog* errors);
+
+/// The OctoMap's settings (~octomap_*): its range and distance bound are the map's (`map`).
+/// octree.resolution_m == 0 turns the OctoMap off (nothing else is then checked).
+struct OctomapSettings {
+  OctreeConfig octree;
+  int queue_size = 2;
+  bool enabled() const { return octree.resolution_m > 0.0; }
+};
+OctomapSettings readOctomapSettings(const ros::NodeHandle& pnh, const TsdfConfig& map,
+                                    ConfigErrorLog* errors);
 
 }  // namespace downstream_perception

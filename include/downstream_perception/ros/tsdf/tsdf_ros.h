@@ -7,7 +7,6 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -19,7 +18,6 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <Eigen/Geometry>
-#include <boost/thread/recursive_mutex.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -40,6 +38,8 @@
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
+#include "downstream_perception/ros/common/rejection_counter.h"
 #include "downstream_perception/ros/common/save_service.h"
 #include "downstream_perception/ros/tsdf/tsdf_mesh_markers.h"
 
@@ -58,7 +58,7 @@ class TsdfRos {
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
   /// The pinhole model for an image from the latest CameraInfo of its frame, or why not.
   bool cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why);
-  /// A MessageFilter into world_frame_ calling on_ready, and reject() with the reason on a drop.
+  /// A MessageFilter into world_frame_ calling on_ready, and rejected_ counts the reason of a drop.
   template <class M>
   void attachTfFilter(FilteredSubscription<M>* filter,
                       void (TsdfRos::*on_ready)(const boost::shared_ptr<const M>&),
@@ -76,7 +76,6 @@ class TsdfRos {
   bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void reconfigure(TsdfNodeletConfig& config, std::uint32_t level);
-  void reject(const std::string& reason, const std::string& detail);
   void account(const TsdfIntegrationStats& stats, double elapsed_ms);
 
   ros::NodeHandle nh_;
@@ -118,7 +117,7 @@ class TsdfRos {
 
   // Diagnostics.
   std::size_t frames_integrated_ = 0;
-  std::map<std::string, std::size_t> rejected_;
+  RejectionCounter rejected_{"tsdf: frame rejected"};
   TsdfIntegrationStats last_;
   std::size_t pixels_invalid_ = 0;
   std::size_t blocks_refused_ = 0;
@@ -132,9 +131,7 @@ class TsdfRos {
   TsdfHealth health_;
   ConfigErrorLog config_errors_;
 
-  using ReconfigureServer = dynamic_reconfigure::Server<TsdfNodeletConfig>;
-  std::unique_ptr<ReconfigureServer> reconfigure_server_;
-  boost::recursive_mutex reconfigure_mutex_;
+  ReconfigureHost<TsdfNodeletConfig> reconfigure_;
   bool reconfigure_started_ = false;
 };
 
