@@ -200,6 +200,29 @@ bool gather(const TsdfMap& map, const Eigen::Vector3i& block, float min_weight, 
   return negative && non_negative;
 }
 
+bool hasZeroArea(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& ids) {
+  const Eigen::Vector3f& a = mesh.vertices[ids[0]];
+  return (mesh.vertices[ids[1]] - a).cross(mesh.vertices[ids[2]] - a).squaredNorm() == 0.0f;
+}
+
+// Exact position of a vertex as a hash key (+0 for -0, so the two zeros weld).
+struct PositionKey {
+  std::array<std::uint32_t, 3> bits;
+  explicit PositionKey(const Eigen::Vector3f& p) {
+    for (int a = 0; a < 3; ++a) {
+      const float v = p(a) + 0.0f;
+      std::memcpy(&bits[a], &v, sizeof(float));
+    }
+  }
+  bool operator==(const PositionKey& o) const { return bits == o.bits; }
+};
+struct PositionKeyHash {
+  std::size_t operator()(const PositionKey& k) const {
+    return (std::size_t{k.bits[0]} * 73856093u) ^ (std::size_t{k.bits[1]} * 19349669u) ^
+           (std::size_t{k.bits[2]} * 83492791u);
+  }
+};
+
 }  // namespace
 
 const std::vector<std::array<int, 3>>& marchingCubesCase(int inside_mask) {
@@ -273,9 +296,11 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
     }
     return g;
   };
-  // Vertex of each lattice edge (corner lattice index * 3 + axis), shared within the block.
+  // Vertex of each lattice edge (lower corner's lattice index * 4 + axis) or lattice point
+  // (index * 4 + kLatticePoint), shared within the block.
   constexpr int kLattice = kTsdfBlockSide + 1;
-  std::array<std::int32_t, kLattice * kLattice * kLattice * 3> vertex_of_edge;
+  constexpr int kLatticePoint = 3;
+  std::array<std::int32_t, kLattice * kLattice * kLattice * 4> vertex_of_edge;
   vertex_of_edge.fill(-1);
   const double s = map.voxelSize();
   const Eigen::Vector3i origin = block * kTsdfBlockSide;
@@ -320,22 +345,27 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
             // Canonical lattice edge: lower corner + axis.
             const std::array<int, 3> a = {x + ca[0], y + ca[1], z + ca[2]};
             const std::array<int, 3> b = {x + cb[0], y + cb[1], z + cb[2]};
-            const std::array<int, 3> lo = {std::min(a[0], b[0]), std::min(a[1], b[1]),
-                                           std::min(a[2], b[2])};
+            const bool a_low = a[0] + a[1] + a[2] < b[0] + b[1] + b[2];
+            const std::array<int, 3>& low = a_low ? a : b;
+            const std::array<int, 3>& high = a_low ? b : a;
             const int axis = a[0] != b[0] ? 0 : (a[1] != b[1] ? 1 : 2);
-            const int key = ((lo[0] + kLattice * (lo[1] + kLattice * lo[2])) * 3) + axis;
+            // Interpolate from the lower lattice end, so the cubes (and blocks) sharing this
+            // edge compute bit-identical vertices: no hairline cracks on block seams.
+            const float d_low = corner[kCubeEdges[e][a_low ? 0 : 1]];
+            const float d_high = corner[kCubeEdges[e][a_low ? 1 : 0]];
+            const float t = d_low / (d_low - d_high);
+            Eigen::Vector3f global((origin.x() + low[0]), (origin.y() + low[1]),
+                                   (origin.z() + low[2]));
+            global(axis) += t;
+            // A crossing that lands on a lattice point (a surface through voxel centres) is
+            // reached from up to six edges: key it by the point, so those edges share one
+            // vertex and the triangles they pinch have equal ids (and are dropped).
+            const bool on_low = global(axis) == static_cast<float>(origin(axis) + low[axis]);
+            const bool on_high = global(axis) == static_cast<float>(origin(axis) + high[axis]);
+            const std::array<int, 3>& point = on_high && !on_low ? high : low;
+            const int kind = on_low || on_high ? kLatticePoint : axis;
+            const int key = (point[0] + kLattice * (point[1] + kLattice * point[2])) * 4 + kind;
             if (vertex_of_edge[key] < 0) {
-              // Interpolate from the lower lattice end, so the cubes (and blocks) sharing this
-              // edge compute bit-identical vertices: no hairline cracks on block seams.
-              const bool a_low = a == lo;
-              const std::array<int, 3>& low = a_low ? a : b;
-              const std::array<int, 3>& high = a_low ? b : a;
-              const float d_low = corner[kCubeEdges[e][a_low ? 0 : 1]];
-              const float d_high = corner[kCubeEdges[e][a_low ? 1 : 0]];
-              const float t = d_low / (d_low - d_high);
-              Eigen::Vector3f global((origin.x() + low[0]), (origin.y() + low[1]),
-                                     (origin.z() + low[2]));
-              global(axis) += t;
               vertex_of_edge[key] = static_cast<std::int32_t>(mesh.vertices.size());
               mesh.vertices.push_back(global * static_cast<float>(s));
               Eigen::Vector3f g = (1.0f - t) * gradient(low[0], low[1], low[2]) +
@@ -345,8 +375,11 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
             }
             ids[k] = static_cast<std::uint32_t>(vertex_of_edge[key]);
           }
-          // Degenerate triangles (a crossing exactly on a shared corner) are dropped.
-          if (ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2]) continue;
+          // Degenerate triangles (two corners pinched into one lattice point, or three
+          // vertices on a line) are dropped: they have no area and no normal.
+          if (ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] || hasZeroArea(mesh, ids)) {
+            continue;
+          }
           mesh.triangles.insert(mesh.triangles.end(), ids.begin(), ids.end());
         }
       }
@@ -381,6 +414,8 @@ std::size_t TsdfMesher::update(const TsdfMap& map) {
 }
 
 TriangleMesh TsdfMesher::combined() const {
+  // Blocks share the vertices on their seams bit for bit (each is interpolated from the lower
+  // lattice end): welded by exact position, every position is one vertex of the whole mesh.
   TriangleMesh all;
   std::size_t vertices = 0, indices = 0;
   for (const auto& [key, mesh] : meshes_) {
@@ -390,7 +425,22 @@ TriangleMesh TsdfMesher::combined() const {
   all.vertices.reserve(vertices);
   all.normals.reserve(vertices);
   all.triangles.reserve(indices);
-  for (const auto& [key, mesh] : meshes_) all.append(mesh);
+  tsl::robin_map<PositionKey, std::uint32_t, PositionKeyHash> id_of_position;
+  id_of_position.reserve(vertices);
+  std::vector<std::uint32_t> id_of_local;
+  for (const auto& [key, mesh] : meshes_) {
+    id_of_local.resize(mesh.vertices.size());
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+      const auto next = static_cast<std::uint32_t>(all.vertices.size());
+      const auto [it, inserted] = id_of_position.try_emplace(PositionKey(mesh.vertices[i]), next);
+      if (inserted) {
+        all.vertices.push_back(mesh.vertices[i]);
+        all.normals.push_back(mesh.normals[i]);
+      }
+      id_of_local[i] = it->second;
+    }
+    for (const std::uint32_t i : mesh.triangles) all.triangles.push_back(id_of_local[i]);
+  }
   return all;
 }
 

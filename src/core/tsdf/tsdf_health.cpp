@@ -4,12 +4,25 @@
 
 namespace downstream_perception {
 
+namespace {
+/// Half-width of the tie band around D = 0, in voxels: far above float rounding (~1e-4 voxel
+/// at 10 m and 2 cm voxels), far below the drift the check is for (more than mu).
+constexpr double kSurfaceTieVoxels = 0.01;
+}  // namespace
+
 TsdfHealth tsdfHealth(const TsdfMap& map) {
   TsdfHealth health;
   const float min_weight = static_cast<float>(map.config().min_weight);
   const double s = map.voxelSize();
   const double mu = map.config().truncation();
   const int reach = std::max(2, static_cast<int>(std::floor(mu / s)));  // voxels within mu
+  // Tie rule: a surface through voxel centres leaves D there at 0 plus rounding of either sign
+  // (each view's projective distance rounds its own way), so neighbours along the surface
+  // would alternate signs and count as crossings and double crossings. Values within a small
+  // fraction of a voxel of 0 count as on the surface, which (as in marching cubes, where
+  // D = 0 is outside) is the non-negative side.
+  const float tie = static_cast<float>(kSurfaceTieVoxels * s / mu);
+  const auto inside = [tie](float d) { return d < -tie; };
   const auto value = [&](const Eigen::Vector3i& v, float* d) {
     const TsdfVoxel* voxel = map.voxel(v);
     if (voxel == nullptr || !(voxel->weight > min_weight)) return false;
@@ -29,7 +42,7 @@ TsdfHealth tsdfHealth(const TsdfMap& map) {
             Eigen::Vector3i step = Eigen::Vector3i::Zero();
             step(axis) = 1;
             float next = 0.0f;
-            if (!value(v + step, &next) || (here.distance < 0.0f) == (next < 0.0f)) continue;
+            if (!value(v + step, &next) || inside(here.distance) == inside(next)) continue;
             ++health.crossings;
             // Gradient at the crossing: central differences around both voxels, in D mu / m.
             Eigen::Vector3d g = Eigen::Vector3d::Zero();
@@ -59,7 +72,7 @@ TsdfHealth tsdfHealth(const TsdfMap& map) {
             for (int k = 2; k <= reach; ++k) {
               float d = 0.0f;
               if (!value(v + step * k, &d)) break;
-              if ((d < 0.0f) != (previous < 0.0f)) {
+              if (inside(d) != inside(previous)) {
                 ++health.double_crossings;
                 break;
               }

@@ -58,7 +58,7 @@ class TsdfMesher {
   /// Blocks extracted by the last update().
   const std::vector<Eigen::Vector3i>& lastUpdated() const { return last_updated_; }
   const BlockMeshes& blocks() const { return meshes_; }
-  /// All blocks in one mesh (vertices on block seams appear once per block).
+  /// All blocks in one mesh, welded: one vertex per position (block seams included).
   TriangleMesh combined() const;
   void clear();
 
