@@ -410,12 +410,14 @@ std::size_t TsdfMesher::update(const TsdfMap& map) {
     last_updated_.push_back(key);
   }
   last_generation_ = map.generation();
+  voxel_size_ = static_cast<float>(map.voxelSize());
   return dirty.size();
 }
 
 TriangleMesh TsdfMesher::combined() const {
   // Blocks share the vertices on their seams bit for bit (each is interpolated from the lower
-  // lattice end): welded by exact position, every position is one vertex of the whole mesh.
+  // lattice end, lattice coordinates scaled by the same float voxel size): welded by exact
+  // position, every position is one vertex of the whole mesh.
   TriangleMesh all;
   std::size_t vertices = 0, indices = 0;
   for (const auto& [key, mesh] : meshes_) {
@@ -426,18 +428,32 @@ TriangleMesh TsdfMesher::combined() const {
   all.normals.reserve(vertices);
   all.triangles.reserve(indices);
   tsl::robin_map<PositionKey, std::uint32_t, PositionKeyHash> id_of_position;
-  id_of_position.reserve(vertices);
+  id_of_position.reserve(vertices / 2);
   std::vector<std::uint32_t> id_of_local;
   for (const auto& [key, mesh] : meshes_) {
+    // Only vertices on the block's faces can be shared; the others are appended unhashed.
+    std::array<float, 3> lower_face, upper_face;
+    for (int a = 0; a < 3; ++a) {
+      lower_face[a] = static_cast<float>(key(a) * kTsdfBlockSide) * voxel_size_;
+      upper_face[a] = static_cast<float>((key(a) + 1) * kTsdfBlockSide) * voxel_size_;
+    }
     id_of_local.resize(mesh.vertices.size());
     for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-      const auto next = static_cast<std::uint32_t>(all.vertices.size());
-      const auto [it, inserted] = id_of_position.try_emplace(PositionKey(mesh.vertices[i]), next);
-      if (inserted) {
-        all.vertices.push_back(mesh.vertices[i]);
-        all.normals.push_back(mesh.normals[i]);
+      const Eigen::Vector3f& p = mesh.vertices[i];
+      auto id = static_cast<std::uint32_t>(all.vertices.size());
+      bool seam = false;
+      for (int a = 0; a < 3; ++a) seam |= p(a) == lower_face[a] || p(a) == upper_face[a];
+      if (seam) {
+        const auto [it, inserted] = id_of_position.try_emplace(PositionKey(p), id);
+        id = it->second;
+        if (!inserted) {
+          id_of_local[i] = id;
+          continue;
+        }
       }
-      id_of_local[i] = it->second;
+      all.vertices.push_back(p);
+      all.normals.push_back(mesh.normals[i]);
+      id_of_local[i] = id;
     }
     for (const std::uint32_t i : mesh.triangles) all.triangles.push_back(id_of_local[i]);
   }

@@ -66,6 +66,7 @@ class TsdfMesher {
   BlockMeshes meshes_;
   std::uint64_t last_generation_ = 0;
   std::vector<Eigen::Vector3i> last_updated_;
+  float voxel_size_ = 0.0f;  ///< of the map last meshed: where block faces lie in combined()
 };
 
 }  // namespace downstream_perception
