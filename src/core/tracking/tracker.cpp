@@ -62,6 +62,11 @@ namespace {
 /// Smallest width / height (px) a coasting image box keeps (its size has a velocity too).
 constexpr double kMinBoxSizePx = 1.0;
 
+/// Slack (s) on max_age_s: a limit of k frame periods (k / fps) and the age of k frames differ
+/// in the last bits (and a ROS stamp near 1.7e9 s is only exact to about 2e-7 s), so without it
+/// a track died one frame early for some k. Far below any frame period.
+constexpr double kAgeToleranceS = 1e-6;
+
 enum class Verdict { kOk, kInvalid, kOutOfRange };
 
 Verdict checkDetection(const Detection& d, TrackerConfig::Mode mode) {
@@ -333,7 +338,8 @@ struct Core : Tracker::Impl {
     for (std::size_t a = 0; a < tracks.size(); ++a) {
       if ((*gone)[a] || tracks[a].state != TrackState::kCoasting) continue;
       for (std::size_t b = 0; b < tracks.size(); ++b) {
-        if ((*gone)[b] || tracks[b].state == TrackState::kTentative) continue;
+        // b == a: a coasting track updated at this very stamp passes every test below.
+        if (b == a || (*gone)[b] || tracks[b].state == TrackState::kTentative) continue;
         if (states[b].last_update_s != now || states[b].birth_s < states[a].last_update_s) {
           continue;
         }
@@ -538,7 +544,8 @@ struct Core : Tracker::Impl {
   // A track without a detection this frame: false if it dies (tentative, or coasted too long),
   // else it coasts.
   bool survivesMiss(Track* track, const State& s, double now) const {
-    if (track->state == TrackState::kTentative || now - s.last_update_s > config.max_age_s) {
+    if (track->state == TrackState::kTentative ||
+        now - s.last_update_s > config.max_age_s + kAgeToleranceS) {
       return false;
     }
     track->state = TrackState::kCoasting;

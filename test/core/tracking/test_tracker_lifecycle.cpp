@@ -139,3 +139,24 @@ TEST(Tracker, ACoastingImageBoxNeverTurnsInsideOut) {
     }
   }
 }
+
+TEST(Tracker, AMaxAgeOfKFramesKeepsATrackForKMisses) {
+  // Issue 21 defect 3: at 25 fps, max_age_s 0.04 and 0.12 dropped a track after 1 and 3 misses
+  // but 0.08 kept it after 2: the age and the limit differed in the last bit. Also at a ROS
+  // epoch, where a stamp is only exact to about 2e-7 s.
+  for (const double epoch : {0.0, 1.7e9}) {
+    for (int k = 1; k <= 8; ++k) {
+      TrackerConfig c;
+      c.min_hits = 1;
+      c.max_age_s = k / 25.0;
+      Tracker tracker(c);
+      tracker.step(epoch, {at(0.0, 0.0, 1)});
+      int misses_survived = 0;
+      for (int i = 1; i <= k + 1 && !tracker.tracks().empty(); ++i) {
+        tracker.step(epoch + i / 25.0, {});
+        misses_survived += tracker.tracks().empty() ? 0 : 1;
+      }
+      EXPECT_EQ(misses_survived, k) << "max_age_s " << c.max_age_s << " at epoch " << epoch;
+    }
+  }
+}

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <stdexcept>
 
 #include "downstream_perception/core/tracking/tracker.h"
 #include "tracker_test_helpers.h"
@@ -96,4 +97,22 @@ TEST(Tracker, NeighboursAndOccludedObjectsAreNotDuplicates) {
   EXPECT_GE(coasting_frames, 9u);  // about max_age_s at 10 Hz
   EXPECT_LE(coasting_frames, 11u);
   EXPECT_EQ(behind.tracks().size(), 1u);
+}
+
+TEST(Tracker, ACoastingTrackIsNeverADuplicateOfItself) {
+  // Issue 21 defect 2: a coasting track updated at this very stamp passed every duplicate test
+  // against itself and was removed (duplicates_removed == 1, track 1 gone).
+  TrackerConfig c;
+  c.min_hits = 1;
+  Tracker tracker(c);
+  tracker.step(1.0, {at(0.0, 0.0, 1)});
+  TrackerStats s;
+  try {
+    s = tracker.step(1.0, {at(5.0, 5.0, 2)});
+  } catch (const std::invalid_argument&) {
+    // A repeated stamp may be refused (one stamp, one frame): then nothing may change.
+  }
+  EXPECT_EQ(s.duplicates_removed, 0u);
+  ASSERT_FALSE(tracker.tracks().empty());
+  EXPECT_EQ(tracker.tracks().front().id, 1u);
 }
