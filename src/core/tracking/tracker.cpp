@@ -409,16 +409,19 @@ struct Core : Tracker::Impl {
     return stats;
   }
 
-  // Checks the stamp and returns the time since the previous frame (0 on the first).
+  // Checks the stamp and returns the time since the previous frame (0 on the first). One stamp
+  // is one frame: a repeated stamp would be a frame with dt = 0, in which a lost track misses
+  // again without ageing (it never died), so it is refused like an older one.
   double advanceClock(double now) {
     if (!(std::abs(now) <= TrackerConfig::kMaxStampS)) {
       throw std::invalid_argument("tracker: stamp must be finite and within 1e10 s, got " +
                                   std::to_string(now));
     }
-    if (started && now < last_stamp) {
-      throw std::invalid_argument("tracker: stamp " + std::to_string(now) +
-                                  " s is older than the previous frame's " +
-                                  std::to_string(last_stamp) + " s");
+    if (started && now <= last_stamp) {
+      throw std::invalid_argument("tracker: stamp " + std::to_string(now) + " s is " +
+                                  (now == last_stamp ? "the previous frame's (one stamp, one frame)"
+                                                     : "older than the previous frame's " +
+                                                           std::to_string(last_stamp) + " s"));
     }
     const double dt = started ? now - last_stamp : 0.0;
     started = true;

@@ -97,3 +97,23 @@ TEST(Tracker, RefusesStampsBeyondRosTime) {
   EXPECT_THROW(tracker.step(std::nan(""), {}), std::invalid_argument);
   EXPECT_NO_THROW(tracker.step(1.7e9, {}));
 }
+
+TEST(Tracker, OneStampIsOneFrameARepeatedStampIsRefused) {
+  // Issue 21 defect 4: a repeated stamp was taken as a frame with dt = 0, so a lost track never
+  // aged (200 calls at one stamp kept it alive). It is refused like an older stamp, and the
+  // refused call changes nothing.
+  TrackerConfig c;
+  c.min_hits = 1;
+  c.max_age_s = 0.2;
+  Tracker tracker(c);
+  tracker.step(0.0, {at(0.0, 0.0, 1)});
+  tracker.step(0.1, {});
+  for (int i = 0; i < 200; ++i) {
+    EXPECT_THROW(tracker.step(0.1, {at(5.0, 5.0, 2)}), std::invalid_argument);
+  }
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks().front().id, 1u);
+  EXPECT_EQ(tracker.tracks().front().state, TrackState::kCoasting);
+  tracker.step(0.3, {});  // 0.3 s since its last update, beyond max_age_s
+  EXPECT_TRUE(tracker.tracks().empty());
+}
