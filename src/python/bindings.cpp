@@ -731,6 +731,7 @@ PYBIND11_MODULE(_core, m) {
                     &TrackerStats::detections_rejected_out_of_range)
       .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass)
       .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass)
+      .def_readonly("unmatched_outside_gate", &TrackerStats::unmatched_outside_gate)
       .def_readonly("births", &TrackerStats::births)
       .def_readonly("deaths", &TrackerStats::deaths)
       .def_readonly("duplicates_removed", &TrackerStats::duplicates_removed)
@@ -749,7 +750,8 @@ PYBIND11_MODULE(_core, m) {
              std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> class_ids,
              std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>
                  covariances,
-             std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> truth_ids) {
+             std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> truth_ids,
+             std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> sizes) {
             const bool image = self.config().mode == TrackerConfig::Mode::kImage;
             const py::ssize_t cols = image ? 4 : 2;
             if (positions.ndim() != 2 || positions.shape(1) != cols) {
@@ -767,6 +769,12 @@ PYBIND11_MODULE(_core, m) {
             if (covariances && (covariances->ndim() != 3 || covariances->shape(0) != n ||
                                 covariances->shape(1) != 2 || covariances->shape(2) != 2)) {
               throw std::invalid_argument("covariances must be (N, 2, 2)");
+            }
+            if (sizes && image) {
+              throw std::invalid_argument("sizes are for metric mode (a box carries its size)");
+            }
+            if (sizes && (sizes->ndim() != 2 || sizes->shape(0) != n || sizes->shape(1) != 2)) {
+              throw std::invalid_argument("sizes must be (N, 2)");
             }
             std::vector<Detection> dets(n);
             const auto p = positions.unchecked<2>();
@@ -786,15 +794,20 @@ PYBIND11_MODULE(_core, m) {
                 d.cov_xy = covariances->at(i, 0, 1);
                 d.cov_yy = covariances->at(i, 1, 1);
               }
+              if (sizes) {
+                d.size_x = sizes->at(i, 0);
+                d.size_y = sizes->at(i, 1);
+              }
             }
             py::gil_scoped_release release;
             return self.step(stamp, dets);
           },
           py::arg("stamp"), py::arg("positions"), py::arg("scores") = py::none(),
           py::arg("class_ids") = py::none(), py::arg("covariances") = py::none(),
-          py::arg("truth_ids") = py::none(),
+          py::arg("truth_ids") = py::none(), py::arg("sizes") = py::none(),
           "One frame: positions (N, 2) in metres (metric mode) or boxes (N, 4) in pixels (image "
-          "mode). Returns TrackerStats.")
+          "mode); sizes (N, 2) in metres (metric mode only: tracks()['size']). Returns "
+          "TrackerStats.")
       .def(
           "tracks",
           [](const Tracker& self) {
