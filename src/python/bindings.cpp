@@ -810,8 +810,11 @@ PYBIND11_MODULE(_core, m) {
           "TrackerStats.")
       .def(
           "tracks",
-          [](const Tracker& self) {
-            const auto& t = self.tracks();
+          [](const Tracker& self, bool include_tentative) {
+            std::vector<Track> t;
+            for (const Track& track : self.tracks()) {
+              if (include_tentative || track.state != TrackState::kTentative) t.push_back(track);
+            }
             const py::ssize_t n = static_cast<py::ssize_t>(t.size());
             py::array_t<std::uint64_t> ids(n);
             py::array_t<int> states(n), hits(n), truth(n);
@@ -846,8 +849,10 @@ PYBIND11_MODULE(_core, m) {
             out["size"] = size;
             return out;
           },
+          py::arg("include_tentative") = true,
           "Live tracks as a dict of numpy arrays (id, state, hits, truth_id, position, velocity, "
-          "position_cov, velocity_cov, size); state: 0 tentative, 1 confirmed, 2 coasting.")
+          "position_cov, velocity_cov, size); state: 0 tentative, 1 confirmed, 2 coasting. "
+          "include_tentative=False leaves out the tracks not yet confirmed.")
       .def("last_assignment", &Tracker::lastAssignment,
            "Per detection of the last step: the id of the track that took it, or 0.")
       .def("reset", &Tracker::reset);

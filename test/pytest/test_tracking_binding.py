@@ -147,3 +147,15 @@ def test_tracker_carries_metric_sizes_and_counts_unmatched_detections() -> None:
     image.mode = dp.TrackerConfig.Mode.IMAGE
     with pytest.raises(ValueError):  # a box carries its size
         dp.Tracker(image).step(0.0, np.array([[0.0, 0.0, 10.0, 10.0]]), sizes=np.ones((1, 2)))
+
+
+def test_tracks_can_leave_out_tentative_tracks() -> None:
+    # Issue 21 item 7: a consumer that reports only established tracks filtered by hand.
+    tracker = dp.Tracker(dp.TrackerConfig())  # min_hits 3: one detection is a tentative track
+    tracker.step(0.0, np.array([[0.0, 0.0]]))
+    assert tracker.tracks()["state"].tolist() == [0]
+    established = tracker.tracks(include_tentative=False)
+    assert established["id"].shape == (0,) and established["position"].shape == (0, 2)
+    for k in (1, 2):
+        tracker.step(0.1 * k, np.array([[0.0, 0.0]]))
+    assert tracker.tracks(include_tentative=False)["state"].tolist() == [1]
