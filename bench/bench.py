@@ -123,6 +123,42 @@ def plot_sweep(sweep: list[dict[str, float]], path: Path) -> bool:
     return True
 
 
+def plot_scan(core: list[dict[str, float]], path: Path) -> bool:
+    """Scan integration and layer update time against beam count, one line per map size, with
+    costmap_2d's ObstacleLayer from the anchor notes (PNG; issue 20). False without matplotlib."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for size in sorted({int(r["map"]) for r in core}):
+        rows = sorted((r for r in core if int(r["map"]) == size), key=lambda r: r["beams"])
+        beams = [r["beams"] for r in rows]
+        line = ax.plot(beams, [r["median_ms"] for r in rows], "o-", label=f"ours {size}^2")[0]
+        ax.plot(beams, [r["layer_update_ms"] for r in rows], "s--", color=line.get_color(),
+                label=f"ours {size}^2, layer update")  # fmt: skip
+    refs = sorted(COSTMAP2D_OBSTACLE_MS.items())
+    ax.plot([b for (_, b), _ in refs], [ms for _, ms in refs], "kx", label="costmap_2d (anchor)")
+    for (size, beams), ms in refs:
+        ax.annotate(
+            f"{size}^2", (beams, ms), fontsize=7, xytext=(4, -8), textcoords="offset points"
+        )
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("beams per scan")
+    ax.set_ylabel("median time per scan (ms)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("scan integration (exact ray clearing, 0.05 m cells, room scene)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return True
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out", help="output folder")
@@ -140,6 +176,7 @@ def main() -> None:
     decay = next(r for r in rows if r["bench"] == "decay")
     tracker = [r for r in rows if r["bench"] == "tracker"]
     plotted = plot_sweep(sweep, out / "bench_inflation.png")
+    scan_plotted = plot_scan(core, out / "bench_scan.png")
     binding = python_binding_overhead()
     sim = simulator_speed()
     tsdf = bench_tsdf.run()
@@ -179,6 +216,10 @@ def main() -> None:
         "master. *touched-window write* is our write over that same window, for comparison. "
         "*first scan* integrates into an all-unknown grid (no cell saturated yet). Cell visits "
         "are per beam (Amanatides-Woo visits |dx|+|dy|+1 cells, Bresenham max(|dx|,|dy|)+1).",
+        "",
+        "![scan time vs beams](bench_scan.png)"
+        if scan_plotted
+        else "(plot skipped: matplotlib not installed)",
         "",
         "## Inflation and whole costmap update (costmap_2d anchor scenarios)",
         "",

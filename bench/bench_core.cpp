@@ -11,6 +11,7 @@
 #include <cstring>
 #include <random>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/costmap/cloud_beams.h"
@@ -475,9 +476,11 @@ int main(int argc, char** argv) {
     return 0;
   }
   const int only_size = argc > 2 ? std::atoi(argv[2]) : 0;  // 0 = all map sizes
-  for (int size : {200, 1000}) {
+  // Scan integration against beams and map size (bench_scan.png): costmap_2d's anchor rooms
+  // (walls at +-4.475 m on 200^2, +-22.475 m on 1000^2) and one between them.
+  const std::pair<int, double> scan_rooms[] = {{200, 4.475}, {500, 11.975}, {1000, 22.475}};
+  for (const auto& [size, room_half] : scan_rooms) {
     if (only_size != 0 && size != only_size) continue;
-    const double room_half = size == 200 ? 4.475 : 22.475;
     for (int beams : {360, 1080, 3600}) runIntegration(size, room_half, beams, iters);
   }
   // The costmap_2d anchor scenarios (radius m, cost_scaling_factor).

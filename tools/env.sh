@@ -25,24 +25,18 @@ system_venv() {
 }
 link_package() {
   # The package as the workspace's source ($1/src/downstream_perception): a directory of links to
-  # the repository's folders and copies of its files, not one link to the repository, so that it does not contain the
+  # the repository's entries, not one link to the repository, so that it does not contain the
   # workspaces themselves (.ws*). rosrun searches the package directory recursively: through a
   # link to the repository it found every script again in .ws/devel, .ws/build and the loop
   # .ws/src/downstream_perception/.ws/... and refused to choose.
   local dest="$1/src/downstream_perception" entry name
   [[ -L "$dest" ]] && rm -f "$dest"
   mkdir -p "$dest"
-  find "$dest" -mindepth 1 -maxdepth 1 \( -type l -o -type f \) -delete
+  find "$dest" -mindepth 1 -maxdepth 1 \( -type l -o -type f \) -delete  # f: copies of old
   for entry in "$REPO"/* "$REPO"/.[!.]*; do
     name="$(basename "$entry")"
     [[ -e "$entry" ]] || continue
     case "$name" in .ws* | .git | .ruff_cache | out) continue ;; esac
-    if [[ -f "$entry" ]]; then
-      # Files are copied (with their times, so nothing rebuilds), folders linked: install()
-      # would copy a link to a file (package.xml, the plugin lists) as a link to the repository.
-      cp -p "$entry" "$dest/$name"
-    else
-      ln -sfn "$entry" "$dest/$name"
-    fi
+    ln -sfn "$entry" "$dest/$name"
   done
 }

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import re
-import socket
 import subprocess
 import sys
 import time
@@ -85,13 +84,9 @@ def plugins(base: str, xml_name: str) -> Callable[[], str]:
     return test
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
 def launch_costmap() -> str:
+    from downstream_perception.ros.processes import free_port  # the installed one
+
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
     launch = subprocess.Popen(

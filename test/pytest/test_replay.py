@@ -5,7 +5,6 @@ be replayed fail before anything starts with a reason and exit status 2."""
 
 from __future__ import annotations
 
-import math
 import os
 import shutil
 import subprocess
@@ -21,64 +20,14 @@ rosbag = pytest.importorskip("rosbag")
 
 import downstream_perception as dp  # noqa: E402
 from downstream_perception import replay  # noqa: E402
-from downstream_perception.planar import se2_matrix  # noqa: E402
-from downstream_perception.ros.util import laser_scan, transform_stamped  # noqa: E402
-from downstream_perception.sim import Lidar, LidarConfig, aisle_drive, warehouse_aisle  # noqa: E402
+from downstream_perception.ros.sim_bags import (  # noqa: E402
+    record_aisle_bag,
+    record_objects_bag,
+    record_room_bag,
+)
+from downstream_perception.sim import warehouse_aisle  # noqa: E402
 
 CONFIG = Path(__file__).resolve().parent / "replay_costmap.yaml"
-START_S = 100.0
-
-
-def record_bag(
-    path: Path,
-    duration_s: float = 8.0,
-    scan_topic: str = "/scan",
-    with_tf: bool = True,
-    tf_jump_at_s: float | None = None,
-) -> Path:
-    """The robot drives the warehouse aisle at 1 m/s: scans at 10 Hz (frame laser), tf
-    map <- odom <- base_link at 50 Hz and a static base_link <- laser."""
-    world, drive = warehouse_aisle(), aisle_drive(1.0)
-    lidar = Lidar(LidarConfig(num_beams=360, range_max=30.0, noise_std_m=0.01, seed=3))
-    map_odom = se2_matrix(0.5, -0.2, 0.05)
-    odom_map = np.linalg.inv(map_odom)
-    from tf2_msgs.msg import TFMessage
-
-    with rosbag.Bag(str(path), "w") as bag:
-        start = rospy.Time.from_sec(START_S)
-        if with_tf:
-            static = transform_stamped("base_link", "laser", start, x=0.0, z=0.2)
-            bag.write("/tf_static", TFMessage([static]), start)
-        for k in range(int(duration_s * 50) + 1):
-            t = k / 50.0
-            stamp_s = START_S + t
-            if tf_jump_at_s is not None and t >= tf_jump_at_s:
-                stamp_s -= 30.0  # the clock went back: a looped recording
-            stamp = rospy.Time.from_sec(stamp_s)
-            x, y, yaw = drive.pose(t)
-            odom_base = odom_map @ se2_matrix(x, y, yaw)
-            if with_tf:
-                tfs = [
-                    transform_stamped("map", "odom", stamp, x=0.5, y=-0.2, yaw=0.05),
-                    transform_stamped(
-                        "odom",
-                        "base_link",
-                        stamp,
-                        x=odom_base[0, 2],
-                        y=odom_base[1, 2],
-                        yaw=math.atan2(odom_base[1, 0], odom_base[0, 0]),
-                    ),
-                ]
-                bag.write("/tf", TFMessage(tfs), rospy.Time.from_sec(START_S + t))
-            if k % 5 == 0:
-                c = lidar.config
-                ranges = lidar.scan(world, (x, y, yaw), t)
-                msg = laser_scan(
-                    stamp, "laser", ranges, c.angle_min, c.angle_increment, c.range_min, c.range_max
-                )
-                msg.scan_time = 0.1
-                bag.write(scan_topic, msg, rospy.Time.from_sec(START_S + t))
-    return path
 
 
 def run_replay(*args: str) -> int:
@@ -105,7 +54,7 @@ def _classes(values: np.ndarray) -> np.ndarray:
 @pytest.fixture(scope="module")
 def replayed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("replay")
-    bag = record_bag(out / "aisle.bag")
+    bag = record_aisle_bag(out / "aisle.bag")
     run_replay(str(bag), "--config", str(CONFIG), "--out", str(out / "result"), "--rate", "4")
     return out / "result"
 
@@ -168,24 +117,26 @@ def _refused(tmp_path: Path, bag: Path, capsys: pytest.CaptureFixture[str]) -> s
 def test_a_bag_without_the_configured_topics_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    err = _refused(tmp_path, record_bag(tmp_path / "b.bag", 1.0, scan_topic="/front_scan"), capsys)
+    err = _refused(
+        tmp_path, record_aisle_bag(tmp_path / "b.bag", 1.0, scan_topic="/front_scan"), capsys
+    )
     assert "none of the costmap's topics is in the bag" in err and "/front_scan" in err
 
 
 def test_a_bag_without_tf_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    err = _refused(tmp_path, record_bag(tmp_path / "b.bag", 1.0, with_tf=False), capsys)
+    err = _refused(tmp_path, record_aisle_bag(tmp_path / "b.bag", 1.0, with_tf=False), capsys)
     assert "no /tf or /tf_static" in err
 
 
 def test_a_clock_that_jumps_back_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    err = _refused(tmp_path, record_bag(tmp_path / "b.bag", 2.0, tf_jump_at_s=1.0), capsys)
+    err = _refused(tmp_path, record_aisle_bag(tmp_path / "b.bag", 2.0, tf_jump_at_s=1.0), capsys)
     assert "the clock jumps back" in err and "30.0 s" in err
 
 
 def test_a_truncated_bag_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    bag = record_bag(tmp_path / "b.bag", 2.0)
+    bag = record_aisle_bag(tmp_path / "b.bag", 2.0)
     data = bag.read_bytes()
     bag.write_bytes(data[: len(data) // 2])
     err = _refused(tmp_path, bag, capsys)
@@ -199,7 +150,7 @@ def test_a_source_of_the_wrong_message_type_is_refused(
     config["obstacles"]["scan"]["data_type"] = "PointCloud2"
     other = tmp_path / "cloud.yaml"
     other.write_text(yaml.safe_dump(config))
-    bag = record_bag(tmp_path / "b.bag", 1.0)
+    bag = record_aisle_bag(tmp_path / "b.bag", 1.0)
     status = replay.main(
         [str(bag), "--config", str(other), "--out", str(tmp_path / "o"), "--quiet"]
     )
@@ -225,37 +176,9 @@ def test_pgm_levels_follow_map_saver() -> None:
 TRACKER_CONFIG = Path(__file__).resolve().parents[2] / "cfg" / "tracker.yaml"
 
 
-def record_detections_bag(path: Path, frames: int = 150, robot_speed: float = 0.5) -> dict:
-    """The object simulator's scene (sim.ObjectScene, 10 Hz) seen from a robot driving along odom
-    x: detections in base_link, tf odom <- base_link. Returns the truth per stamp (s)."""
-    from tf2_msgs.msg import TFMessage
-
-    from downstream_perception.ros.util import detection_array
-    from downstream_perception.sim import ObjectScene, SceneConfig
-
-    config = SceneConfig(num_objects=20, rate_hz=10.0, seed=4)
-    scene = ObjectScene(config)
-    truth = {}
-    with rosbag.Bag(str(path), "w") as bag:
-        for _ in range(frames):
-            f = scene.step()
-            t = START_S + f.stamp
-            stamp = rospy.Time.from_sec(t)
-            robot_x = robot_speed * f.stamp
-            tf = transform_stamped("odom", "base_link", stamp, x=robot_x)
-            bag.write("/tf", TFMessage([tf]), stamp)
-            in_base = f.positions - np.array([robot_x, 0.0])
-            msg = detection_array(
-                stamp, "base_link", in_base, f.scores, f.detection_truth, config.noise_std_m**2
-            )
-            bag.write("/detections", msg, stamp + rospy.Duration.from_sec(0.001))
-            truth[round(t, 6)] = (f.truth_ids[f.visible], f.truth_positions[f.visible])
-    return truth
-
-
 def test_tracks_written_as_csv_match_the_truth(tmp_path: Path) -> None:
     mm = pytest.importorskip("motmetrics")
-    truth = record_detections_bag(tmp_path / "objects.bag")
+    truth = record_objects_bag(tmp_path / "objects.bag")
     out = tmp_path / "result"
     bag = str(tmp_path / "objects.bag")
     run_replay(bag, "--tracker", str(TRACKER_CONFIG), "--out", str(out), "--rate", "4")
@@ -288,38 +211,6 @@ def test_tracks_written_as_csv_match_the_truth(tmp_path: Path) -> None:
 TSDF_CONFIG = Path(__file__).resolve().parent / "replay_tsdf.yaml"
 
 
-def record_depth_bag(path: Path, frames: int = 12) -> None:
-    """The analytic room (sim.depth_camera.room_scene) seen at 160 x 120 from poses on a circle,
-    5 Hz: tf odom <- camera (optical), depth/camera_info and depth/image (32FC1, NaN no hit)."""
-    from sensor_msgs.msg import CameraInfo, Image
-    from tf2_msgs.msg import TFMessage
-
-    from downstream_perception.ros.util import transform_from_matrix
-    from downstream_perception.sim.depth_camera import DepthCamera, circle_poses, room_scene
-
-    cam = DepthCamera(160, 120, 131.25, 131.25, 79.5, 59.5)
-    scene, poses = room_scene(), circle_poses(frames)
-    with rosbag.Bag(str(path), "w") as bag:
-        for k, pose in enumerate(poses):
-            stamp = rospy.Time.from_sec(START_S + 0.2 * k)
-            bag.write(
-                "/tf", TFMessage([transform_from_matrix("odom", "camera", stamp, pose)]), stamp
-            )
-            depth = cam.render(scene, pose)
-            info = CameraInfo()
-            info.header.stamp, info.header.frame_id = stamp, "camera"
-            info.width, info.height = cam.width, cam.height
-            info.K = [cam.fx, 0.0, cam.cx, 0.0, cam.fy, cam.cy, 0.0, 0.0, 1.0]
-            image = Image()
-            image.header = info.header
-            image.height, image.width = depth.shape
-            image.encoding, image.step = "32FC1", cam.width * 4
-            image.data = depth.astype("<f4").tobytes()
-            later = stamp + rospy.Duration.from_sec(0.01)
-            bag.write("/depth/camera_info", info, later)
-            bag.write("/depth/image", image, later)
-
-
 def read_ply_vertices(path: Path) -> np.ndarray:
     data = path.read_bytes()
     end = data.index(b"end_header\n") + len(b"end_header\n")
@@ -333,7 +224,7 @@ def read_ply_vertices(path: Path) -> np.ndarray:
 def test_the_mesh_and_the_octomap_are_written(tmp_path: Path) -> None:
     from downstream_perception.sim.depth_camera import room_scene
 
-    record_depth_bag(tmp_path / "room.bag")
+    record_room_bag(tmp_path / "room.bag")
     out = tmp_path / "result"
     run_replay(str(tmp_path / "room.bag"), "--tsdf", str(TSDF_CONFIG), "--out", str(out))
     vertices = read_ply_vertices(out / "mesh.ply")
@@ -344,3 +235,38 @@ def test_the_mesh_and_the_octomap_are_written(tmp_path: Path) -> None:
     assert octomap.startswith(b"# Octomap OcTree binary file") and len(octomap) > 1000
     report = (out / "report.md").read_text()
     assert "TSDF mesh:" in report and "mesh.ply" in report
+
+
+def test_an_earlier_replay_is_kept_unless_overwrite_is_asked(
+    replayed: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = (replayed / "report.md").read_bytes()
+    bag = replayed.parent / "aisle.bag"
+    status = replay.main([str(bag), "--config", str(CONFIG), "--out", str(replayed), "--quiet"])
+    assert status == 2
+    assert "--overwrite" in capsys.readouterr().err
+    assert (replayed / "report.md").read_bytes() == before
+
+
+def test_the_track_log_stays_bounded(tmp_path: Path) -> None:
+    from types import SimpleNamespace
+
+    from downstream_perception.replay.outputs import TrackLog
+
+    def track(i: int, k: int, state: int = 1) -> SimpleNamespace:
+        return SimpleNamespace(
+            id=i, state=state, label="person", position=SimpleNamespace(x=k * 0.1, y=i, z=0.0),
+            velocity=SimpleNamespace(x=1.0, y=0.0, z=0.0), position_covariance=[0.01, 0, 0, 0.01],
+            velocity_covariance=[0.1, 0, 0, 0.1], size_x=0.5, size_y=0.5, score=0.9, truth_id=i,
+        )  # fmt: skip
+
+    log = TrackLog(tmp_path / "tracks.csv", max_points=1000)
+    for k in range(2000):
+        log.add(k * 0.1, [track(1, k), track(2, k), track(3, k, state=0)])
+    log.close()
+    assert log.rows == 6000
+    assert sum(len(xy) for xy in log.trajectories.values()) <= 1001
+    assert set(log.trajectories) == {1, 2}  # tentative tracks are not drawn
+    lines = (tmp_path / "tracks.csv").read_text().splitlines()
+    assert len(lines) == 6001 and lines[0].startswith("stamp,id,state,label,x,y")
+    assert lines[1].split(",")[2] == "confirmed" and lines[3].split(",")[2] == "tentative"

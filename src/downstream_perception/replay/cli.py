@@ -18,6 +18,13 @@ from downstream_perception.replay.pipeline import (
 )
 from downstream_perception.replay.run import ReplayOptions, ReplayResult, replay
 
+# Every file a replay writes into --out: an earlier replay's are replaced only with --overwrite.
+OUTPUTS = [
+    Path(name)
+    for name in ("costmap.pgm", "costmap.yaml", "tracks.csv", "mesh.ply", "octomap.bt", "map.png",
+                 "transform_ages.png", "report.md", "report.html")
+]  # fmt: skip
+
 DESCRIPTION = """Replay a recorded bag through the same nodelets and YAML as on the robot, and
 collect what they made.
 
@@ -50,6 +57,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--settle-s", type=float, default=2.0, help="sim s after the last message")
     ap.add_argument("--timeout-s", type=float, default=60.0, help="for nodelets to start/publish")
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
+    ap.add_argument("--overwrite", action="store_true", help="replace an earlier replay's files")
     args = ap.parse_args(argv)
     if not (args.config or args.tracker or args.tsdf):
         ap.error("name at least one of --config (costmap), --tracker, --tsdf")
@@ -78,13 +86,14 @@ def write_outputs(out: Path, pipeline: Pipeline, summary: BagSummary, result: Re
         files["map"], files["map yaml"] = outputs.write_map(
             c.grid, c.resolution, c.origin, out / "costmap"
         )
-    if pipeline.capability("tracker"):
-        files["tracks"] = outputs.write_tracks_csv(result.tracks, out / "tracks.csv")
-    if c is not None or result.tracks:
+    trajectories = result.tracks.trajectories if result.tracks else {}
+    if result.tracks is not None:
+        files["tracks"] = result.tracks.path
+    if c is not None or trajectories:
         title = "final costmap, robot path and tracks" if c is not None else "tracks"
         grid, res, origin = (c.grid, c.resolution, c.origin) if c else (None, 1.0, (0.0, 0.0))
         png = outputs.render_map_png(
-            grid, res, origin, result.path_xy, result.tracks, out / "map.png", title
+            grid, res, origin, result.path_xy, trajectories, out / "map.png", title
         )
         images.append((title.capitalize(), png))
     ages = outputs.render_histograms(summary.transform_ages_s, out / "transform_ages.png")
@@ -115,9 +124,9 @@ def report_lines(
             f"- costmap: {g.grid.shape[1]} x {g.grid.shape[0]} cells at {g.resolution:.3f} m; "
             f"lethal {lethal}, free {free}, unknown {int((g.grid < 0).sum())}"
         )
-    if pipeline.capability("tracker"):
-        ids = {row[1] for row in result.tracks if row[2] == "confirmed"}
-        lines.append(f"- tracks: {len(result.tracks)} rows, {len(ids)} confirmed ids")
+    if result.tracks is not None:
+        ids = len(result.tracks.trajectories)
+        lines.append(f"- tracks: {result.tracks.rows} rows, {ids} confirmed ids")
     lines += [f"- TSDF {what}: {where}" for what, where in result.saved.items()]
     lines += ["", "| topic | type | in the bag | replayed |", "|---|---|---|---|"]
     for topic, (kind, n) in sorted(summary.topics.items()):
@@ -137,9 +146,15 @@ def report_lines(
 
 def main(argv: list[str] | None = None) -> int:
     args = parse(argv)
-    options = ReplayOptions(args.rate, args.settle_s, args.timeout_s, args.quiet)
+    options = ReplayOptions(args.rate, args.settle_s, args.timeout_s, args.quiet, args.overwrite)
     try:
         pipeline = pipeline_of(args)
+        earlier = [p.name for p in OUTPUTS if (args.out / p).exists()]
+        if earlier and not args.overwrite:
+            raise ReplayError(
+                f"{args.out} holds an earlier replay ({', '.join(earlier)}): pass --overwrite to "
+                "replace it, or choose another --out"
+            )
         summary, result = replay(args.bag, pipeline, args.out, options)
     except ReplayError as e:
         print(f"replay: {e}", file=sys.stderr)

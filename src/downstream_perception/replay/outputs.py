@@ -88,12 +88,39 @@ def track_row(stamp: float, track: Any) -> list[Any]:
     ]  # fmt: skip
 
 
-def write_tracks_csv(rows: list[list[Any]], path: Path) -> Path:
-    with path.open("w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(TRACK_COLUMNS)
-        writer.writerows(rows)
-    return path
+class TrackLog:
+    """tracks.csv written as the tracks arrive, and the confirmed tracks' trajectories for the
+    plot, thinned (every 2nd, 4th, ... point) to at most `max_points`: memory stays bounded
+    however long the bag."""
+
+    def __init__(self, path: Path, max_points: int = 200_000) -> None:
+        self.path, self.max_points = path, max_points
+        self._file = path.open("w", newline="")
+        self._writer = csv.writer(self._file)
+        self._writer.writerow(TRACK_COLUMNS)
+        self.rows = 0
+        self.trajectories: dict[int, list[tuple[float, float]]] = {}
+        self._points, self._stride, self._confirmed_rows = 0, 1, 0
+
+    def add(self, stamp: float, tracks: list[Any]) -> None:
+        for track in tracks:
+            self._writer.writerow(track_row(stamp, track))
+            self.rows += 1
+            if track.state != 1:
+                continue
+            self._confirmed_rows += 1
+            if self._confirmed_rows % self._stride == 0:
+                xy = (track.position.x, track.position.y)
+                self.trajectories.setdefault(int(track.id), []).append(xy)
+                self._points += 1
+            if self._points > self.max_points:
+                for key, xy in self.trajectories.items():
+                    self.trajectories[key] = xy[::2]
+                self._points = sum(len(xy) for xy in self.trajectories.values())
+                self._stride *= 2
+
+    def close(self) -> None:
+        self._file.close()
 
 
 def _pyplot() -> Any:
@@ -110,7 +137,7 @@ def render_map_png(
     resolution: float,
     origin: tuple[float, float],
     path_xy: np.ndarray,
-    tracks: list[list[Any]],
+    trajectories: dict[int, list[tuple[float, float]]],
     out: Path,
     title: str,
 ) -> Path:
@@ -142,10 +169,7 @@ def render_map_png(
     if len(path_xy):
         ax.plot(path_xy[:, 0], path_xy[:, 1], "-", color="#d62728", lw=1.5, label="robot path")
         ax.plot(*path_xy[0], "o", color="#2ca02c", label="start")
-    by_id: dict[int, list[tuple[float, float]]] = {}
-    for row in tracks:
-        if row[2] == "confirmed":
-            by_id.setdefault(int(row[1]), []).append((float(row[4]), float(row[5])))
+    by_id = trajectories
     colours = matplotlib.colormaps["tab20"]
     for k, (_, xy) in enumerate(sorted(by_id.items())):
         points = np.asarray(xy)

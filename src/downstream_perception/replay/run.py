@@ -18,7 +18,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from downstream_perception.replay.bag import TF_TOPICS, BagSummary, check, open_bag, summarize
-from downstream_perception.replay.outputs import track_row
+from downstream_perception.replay.outputs import TrackLog
 from downstream_perception.replay.pipeline import Pipeline, ReplayError
 from downstream_perception.replay.progress import Progress
 
@@ -38,6 +38,7 @@ class ReplayOptions:
     settle_s: float = 2.0  # simulated seconds after the last message (tf filters, timers)
     timeout_s: float = 60.0  # for the nodelets to subscribe, and for the last costmap
     quiet: bool = False  # no progress bar
+    overwrite: bool = False  # replace the outputs of an earlier replay in --out
 
 
 @dataclass
@@ -53,7 +54,7 @@ class ReplayResult:
     messages: Counter[str]
     diagnostics: dict[str, str]
     costmap: CostmapResult | None = None
-    tracks: list[list[Any]] = field(default_factory=list)  # outputs.TRACK_COLUMNS rows
+    tracks: TrackLog | None = None  # tracks.csv, written while the bag plays
     saved: dict[str, str] = field(default_factory=dict)  # what the TSDF nodelet wrote, or why not
     path_xy: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
@@ -127,7 +128,7 @@ def replay(
             launch.write_text(launch_file(pipeline, out))
             procs = [subprocess.Popen(["roscore", "-p", str(port)], stdout=log, stderr=log)]
             try:
-                run = NodeletRun(bag, summary, pipeline, options)
+                run = NodeletRun(bag, summary, pipeline, out, options)
                 run.start(launch, port, procs, log)
                 result = run.play()
                 result.path_xy = path_xy
@@ -142,12 +143,15 @@ def replay(
 class NodeletRun:
     """The nodelets on a private master, fed the bag on simulated time."""
 
-    def __init__(self, bag: Any, summary: BagSummary, pipeline: Pipeline, options: ReplayOptions):
+    def __init__(
+        self, bag: Any, summary: BagSummary, pipeline: Pipeline, out: Path, options: ReplayOptions
+    ) -> None:
         self.bag, self.summary, self.pipeline, self.options = bag, summary, pipeline, options
+        self.out = out
         self.topics = [i.topic for i in pipeline.inputs if i.topic in summary.topics]
         self.topics += [t for t in TF_TOPICS if t in summary.topics]
         self.diagnostics: dict[str, str] = {}
-        self.tracks: list[list[Any]] = []
+        self.tracks: TrackLog | None = None
         self.costmap: Any = None
 
     def start(self, launch: Path, port: int, procs: list[Any], log: Any) -> None:
@@ -177,6 +181,7 @@ class NodeletRun:
         if self.pipeline.capability("tracker"):
             from downstream_perception.msg import TrackedObjectArray
 
+            self.tracks = TrackLog(self.out / "tracks.csv")
             rospy.Subscriber(TRACKS_TOPIC, TrackedObjectArray, self._on_tracks, queue_size=1000)
         self.publishers = self._subscribed_publishers()
 
@@ -186,8 +191,7 @@ class NodeletRun:
                 self.diagnostics.update({f"{status.name}: {v.key}": v.value for v in status.values})
 
     def _on_tracks(self, msg: Any) -> None:
-        stamp = msg.header.stamp.to_sec()
-        self.tracks += [track_row(stamp, t) for t in msg.tracks]
+        self.tracks.add(msg.header.stamp.to_sec(), msg.tracks)
 
     def _subscribed_publishers(self) -> dict[str, Any]:
         """A publisher per topic, of the bag's message class, once a nodelet subscribes."""
@@ -247,7 +251,9 @@ class NodeletRun:
             result.saved = self._save_tsdf()
         time.sleep(1.0)  # one more diagnostics round
         result.diagnostics = dict(self.diagnostics)
-        result.tracks = list(self.tracks)
+        if self.tracks is not None:
+            self.tracks.close()
+        result.tracks = self.tracks
         return result
 
     def _final_costmap(self) -> CostmapResult:
@@ -275,7 +281,8 @@ class NodeletRun:
         for what, (service, name) in TSDF_SAVES.items():
             try:
                 rospy.wait_for_service(service, timeout=self.options.timeout_s)
-                reply = rospy.ServiceProxy(service, SaveMap)(path=name, overwrite=True)
+                save = rospy.ServiceProxy(service, SaveMap)
+                reply = save(path=name, overwrite=self.options.overwrite)
             except (rospy.ROSException, rospy.ServiceException) as e:
                 saved[what] = f"not saved: {e}"
                 continue

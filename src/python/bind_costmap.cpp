@@ -1,0 +1,392 @@
+// Python bindings of the core's log-odds grid, scan and cloud integration, static map, inflation
+// and footprint.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <stdexcept>
+
+#include "downstream_perception/core/costmap/cloud_beams.h"
+#include "downstream_perception/core/costmap/footprint.h"
+#include "downstream_perception/core/costmap/inflation.h"
+#include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/core/costmap/scan_integrator.h"
+#include "downstream_perception/core/costmap/static_map.h"
+#include "downstream_perception/core/grid/cost_values.h"
+#include "downstream_perception/core/grid/grid_geometry.h"
+#include "downstream_perception/core/grid/ray_traversal.h"
+#include "downstream_perception/core/grid/se2.h"
+#include "downstream_perception/core/handoff/seam_health.h"
+#include "downstream_perception/core/tracking/assignment.h"
+#include "downstream_perception/core/tracking/box.h"
+#include "downstream_perception/core/tracking/kalman.h"
+#include "downstream_perception/core/tracking/predicted_footprint.h"
+#include "downstream_perception/core/tracking/tracker.h"
+
+#include "numpy_arrays.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;          // NOLINT
+using namespace downstream_perception::python;  // NOLINT
+
+void bindCostmap(py::module& m) {
+  // ----------------------------------------------------------------- log-odds grid
+  py::class_<LogOddsConfig>(m, "LogOddsConfig")
+      .def(py::init<>())
+      .def_readwrite("p_hit", &LogOddsConfig::p_hit)
+      .def_readwrite("p_miss", &LogOddsConfig::p_miss)
+      .def_readwrite("clamp_min", &LogOddsConfig::clamp_min)
+      .def_readwrite("clamp_max", &LogOddsConfig::clamp_max)
+      .def_readwrite("occupied_threshold", &LogOddsConfig::occupied_threshold)
+      .def_readwrite("free_threshold", &LogOddsConfig::free_threshold)
+      .def("validate", &LogOddsConfig::validate, "Empty string if valid, else the reason.");
+
+  py::class_<LogOddsGrid>(m, "LogOddsGrid",
+                          "Fixed-point log-odds occupancy grid (2 bytes per cell, quantum 1/1024).")
+      .def(py::init<const GridGeometry&, const LogOddsConfig&>(), py::arg("geometry"),
+           py::arg("config") = LogOddsConfig{})
+      .def_property_readonly("geometry", &LogOddsGrid::geometry)
+      .def_property_readonly("config", &LogOddsGrid::config)
+      .def_property_readonly_static("quantum", [](py::object) { return LogOddsGrid::kQuantum; })
+      .def_property_readonly(
+          "hit_increment",
+          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.hitUnits()); })
+      .def_property_readonly(
+          "miss_increment",
+          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.missUnits()); })
+      .def(
+          "log_odds",
+          [](const LogOddsGrid& g) {
+            return gridArray<float>(
+                g, [&g](std::size_t i) { return static_cast<float>(g.logOdds(i)); });
+          },
+          "(size_y, size_x) float32 log-odds.")
+      .def(
+          "probability",
+          [](const LogOddsGrid& g) {
+            return gridArray<float>(
+                g, [&g](std::size_t i) { return static_cast<float>(g.probability(i)); });
+          },
+          "(size_y, size_x) float32 P(occupied).")
+      .def(
+          "states",
+          [](const LogOddsGrid& g) {
+            return gridArray<std::int8_t>(
+                g, [&g](std::size_t i) { return static_cast<std::int8_t>(g.state(i)); });
+          },
+          "(size_y, size_x) int8: -1 unknown, 0 free, 1 occupied (by the thresholds).")
+      .def("set_log_odds",
+           [](LogOddsGrid& g,
+              py::array_t<double, py::array::c_style | py::array::forcecast> values) {
+             const GridGeometry& geo = g.geometry();
+             if (values.ndim() != 2 || values.shape(0) != geo.sizeY() ||
+                 values.shape(1) != geo.sizeX()) {
+               throw std::invalid_argument("expected an array of shape (size_y, size_x)");
+             }
+             const double* v = values.data();
+             for (std::size_t i = 0; i < geo.cellCount(); ++i) g.setLogOdds(i, v[i]);
+           })
+      .def("add_hit",
+           [](LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return LogOddsGrid::dequantize(g.addHit(g.geometry().index(x, y)));
+           })
+      .def("add_miss",
+           [](LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return LogOddsGrid::dequantize(g.addMiss(g.geometry().index(x, y)));
+           })
+      .def("cell_log_odds",
+           [](const LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return g.logOdds(g.geometry().index(x, y));
+           })
+      .def("cell_probability",
+           [](const LogOddsGrid& g, int x, int y) {
+             checkIndex(g, x, y);
+             return g.probability(g.geometry().index(x, y));
+           })
+      .def("reset", &LogOddsGrid::reset)
+      .def("shift", &LogOddsGrid::shift, py::arg("dx"), py::arg("dy"))
+      .def(
+          "decay",
+          [](LogOddsGrid& self, double factor) {
+            CellBounds all;
+            all.expand(0, 0);
+            all.expand(self.geometry().sizeX() - 1, self.geometry().sizeY() - 1);
+            std::size_t changed = 0;
+            self.decay(factor, all, &changed);
+            return changed;
+          },
+          py::arg("factor"),
+          "Every cell's log-odds times factor in [0, 1] (exp(-dt / tau)), rounded toward zero. "
+          "Returns how many cells changed state.")
+      .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds)
+      .def_property_readonly("memory_bytes", &LogOddsGrid::memoryBytes);
+
+  m.def("log_odds_of", &LogOddsGrid::logOddsOf, "log(p / (1 - p))");
+  m.def("probability_of", &LogOddsGrid::probabilityOf, "1 - 1 / (1 + exp(l))");
+
+  // ----------------------------------------------------------------- scan integration
+  py::class_<ScanIntegratorConfig>(m, "ScanIntegratorConfig")
+      .def(py::init<>())
+      .def_readwrite("marking", &ScanIntegratorConfig::marking)
+      .def_readwrite("clearing", &ScanIntegratorConfig::clearing)
+      .def_readwrite("obstacle_min_range", &ScanIntegratorConfig::obstacle_min_range)
+      .def_readwrite("obstacle_max_range", &ScanIntegratorConfig::obstacle_max_range)
+      .def_readwrite("raytrace_min_range", &ScanIntegratorConfig::raytrace_min_range)
+      .def_readwrite("raytrace_max_range", &ScanIntegratorConfig::raytrace_max_range)
+      .def_readwrite("inf_is_valid", &ScanIntegratorConfig::inf_is_valid)
+      .def_readwrite("range_max_is_no_return", &ScanIntegratorConfig::range_max_is_no_return)
+      .def("validate", &ScanIntegratorConfig::validate);
+
+  py::class_<IntegrationStats>(m, "IntegrationStats")
+      .def_readonly("beams", &IntegrationStats::beams)
+      .def_readonly("beams_marked", &IntegrationStats::beams_marked)
+      .def_readonly("beams_no_return", &IntegrationStats::beams_no_return)
+      .def_readonly("beams_invalid", &IntegrationStats::beams_invalid)
+      .def_readonly("beams_beyond_obstacle_range", &IntegrationStats::beams_beyond_obstacle_range)
+      .def_readonly("cells_cleared", &IntegrationStats::cells_cleared)
+      .def_readonly("cells_marked", &IntegrationStats::cells_marked)
+      .def_readonly("cells_changed", &IntegrationStats::cells_changed)
+      .def_readonly("points_outside_height", &IntegrationStats::points_outside_height)
+      .def_readonly("points_merged", &IntegrationStats::points_merged)
+      .def_property_readonly(
+          "touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
+          "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
+      .def_property_readonly("changed",
+                             [](const IntegrationStats& s) { return boundsToTuple(s.changed); })
+      .def("clear_mark_ratio", &IntegrationStats::clearMarkRatio);
+
+  py::class_<ScanIntegrator>(m, "ScanIntegrator")
+      .def(py::init<const ScanIntegratorConfig&>(), py::arg("config") = ScanIntegratorConfig{})
+      .def_property_readonly("config", &ScanIntegrator::config)
+      .def(
+          "integrate",
+          [](ScanIntegrator& self, LogOddsGrid& grid,
+             py::array_t<float, py::array::c_style | py::array::forcecast> ranges, double angle_min,
+             double angle_increment, double range_min, double range_max,
+             std::tuple<double, double, double> pose) {
+            if (ranges.ndim() != 1) throw std::invalid_argument("ranges must be 1-D");
+            LaserScanView view{ranges.data(), static_cast<std::size_t>(ranges.shape(0)),
+                               angle_min,     angle_increment,
+                               range_min,     range_max};
+            const Pose2D p{std::get<0>(pose), std::get<1>(pose), std::get<2>(pose)};
+            py::gil_scoped_release release;
+            return self.integrate(grid, view, p);
+          },
+          py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
+          py::arg("range_min"), py::arg("range_max"), py::arg("sensor_pose"),
+          "Integrates one LaserScan (REP-117 semantics) taken at sensor_pose = (x, y, yaw) in the "
+          "grid frame. Raises ValueError for a malformed scan header.")
+      .def(
+          "integrate_moving",
+          [](ScanIntegrator& self, LogOddsGrid& grid,
+             py::array_t<float, py::array::c_style | py::array::forcecast> ranges, double angle_min,
+             double angle_increment, double range_min, double range_max,
+             std::tuple<double, double, double> first, std::tuple<double, double, double> last) {
+            if (ranges.ndim() != 1) throw std::invalid_argument("ranges must be 1-D");
+            LaserScanView view{ranges.data(), static_cast<std::size_t>(ranges.shape(0)),
+                               angle_min,     angle_increment,
+                               range_min,     range_max};
+            const std::string why = view.validate();
+            if (!why.empty()) throw std::invalid_argument(why);
+            const Pose2D a{std::get<0>(first), std::get<1>(first), std::get<2>(first)};
+            const Pose2D b{std::get<0>(last), std::get<1>(last), std::get<2>(last)};
+            py::gil_scoped_release release;
+            std::vector<BeamUpdate> beams;
+            IntegrationStats decisions;
+            self.beamsFromMovingScan(view, a, b, &beams, &decisions);
+            return self.integrate(grid, beams, decisions);
+          },
+          py::arg("grid"), py::arg("ranges"), py::arg("angle_min"), py::arg("angle_increment"),
+          py::arg("range_min"), py::arg("range_max"), py::arg("first_beam_pose"),
+          py::arg("last_beam_pose"),
+          "Like integrate(), for a scan swept while the sensor moved: each beam is cast from the "
+          "pose interpolated between the first and the last beam's pose (per-beam correction).")
+      .def(
+          "integrate_cloud",
+          [](ScanIntegrator& self, LogOddsGrid& grid,
+             py::array_t<float, py::array::c_style | py::array::forcecast> points,
+             py::array_t<double, py::array::c_style | py::array::forcecast> grid_from_sensor,
+             double min_obstacle_height, double max_obstacle_height, bool merge_cells) {
+            if (points.ndim() != 2 || points.shape(1) != 3) {
+              throw std::invalid_argument("points must be an (N, 3) array");
+            }
+            if (grid_from_sensor.ndim() != 2 || grid_from_sensor.shape(0) != 4 ||
+                grid_from_sensor.shape(1) != 4) {
+              throw std::invalid_argument("grid_from_sensor must be a 4 x 4 matrix");
+            }
+            CloudBeamsConfig config;
+            config.min_obstacle_height = min_obstacle_height;
+            config.max_obstacle_height = max_obstacle_height;
+            if (merge_cells) config.merge_grid = grid.geometry();
+            const std::string why = config.validate();
+            if (!why.empty()) throw std::invalid_argument(why);
+            Eigen::Matrix4d m;
+            for (int r = 0; r < 4; ++r) {
+              for (int c = 0; c < 4; ++c) m(r, c) = grid_from_sensor.at(r, c);
+            }
+            Eigen::Isometry3d pose(m);
+            py::gil_scoped_release release;
+            std::vector<BeamUpdate> beams;
+            IntegrationStats decisions;
+            beamsFromCloud(self, config, reinterpret_cast<const unsigned char*>(points.data()),
+                           static_cast<std::size_t>(points.shape(0)), 3 * sizeof(float), pose,
+                           &beams, &decisions);
+            return self.integrate(grid, beams, decisions);
+          },
+          py::arg("grid"), py::arg("points"), py::arg("grid_from_sensor"),
+          py::arg("min_obstacle_height") = 0.0, py::arg("max_obstacle_height") = 2.0,
+          py::arg("merge_cells") = false,
+          "Integrates an (N, 3) point cloud in the sensor frame placed by the 4 x 4 transform "
+          "grid_from_sensor; points outside the height band (grid frame z, m) are skipped; with "
+          "merge_cells one beam per grid cell (the first point in it).");
+
+  // ----------------------------------------------------------------- static map
+  py::class_<StaticMapConfig>(m, "StaticMapConfig")
+      .def(py::init<>())
+      .def_readwrite("track_unknown_space", &StaticMapConfig::track_unknown_space)
+      .def_readwrite("use_maximum", &StaticMapConfig::use_maximum)
+      .def_readwrite("lethal_cost_threshold", &StaticMapConfig::lethal_cost_threshold,
+                     "occupancy value 0..100 (clamped) from which a cell is lethal")
+      .def_readwrite("unknown_cost_value", &StaticMapConfig::unknown_cost_value,
+                     "occupancy value meaning unknown, compared as a byte (-1 = 255)")
+      .def_readwrite("trinary_costmap", &StaticMapConfig::trinary_costmap)
+      .def_readwrite("max_cells", &StaticMapConfig::max_cells, "largest map accepted, cells");
+  m.def(
+      "static_map_values",
+      [](py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> occupancy,
+         const StaticMapConfig& config) {
+        const auto table = staticValueTable(config);
+        py::array_t<std::uint8_t> out(
+            std::vector<py::ssize_t>(occupancy.shape(), occupancy.shape() + occupancy.ndim()));
+        const std::int8_t* in = occupancy.data();
+        std::uint8_t* o = out.mutable_data();
+        for (py::ssize_t k = 0; k < occupancy.size(); ++k) {
+          o[k] = table[static_cast<std::uint8_t>(in[k])];
+        }
+        return out;
+      },
+      py::arg("occupancy"), py::arg("config") = StaticMapConfig(),
+      "nav_msgs/OccupancyGrid values (int8, any shape) -> costs, costmap_2d's StaticLayer "
+      "mapping.");
+  py::class_<StaticMap>(m, "StaticMap")
+      .def(py::init<const StaticMapConfig&>(), py::arg("config") = StaticMapConfig())
+      .def(
+          "set_map",
+          [](StaticMap& self,
+             py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> data,
+             double resolution, double origin_x, double origin_y) {
+            if (data.ndim() != 2) throw std::invalid_argument("data must be a 2-D [y, x] array");
+            StaticMapInfo info;
+            info.height = data.shape(0), info.width = data.shape(1);
+            info.resolution = resolution, info.origin_x = origin_x, info.origin_y = origin_y;
+            info.data_size = static_cast<std::size_t>(data.size());
+            const std::string why = self.setMap(info, data.data());
+            if (!why.empty()) throw std::invalid_argument(why);
+          },
+          py::arg("data"), py::arg("resolution"), py::arg("origin_x") = 0.0,
+          py::arg("origin_y") = 0.0,
+          "Replaces the map ([y, x] int8 occupancy); ValueError (map kept) if it is refused.")
+      .def(
+          "apply_update",
+          [](StaticMap& self, std::int64_t x, std::int64_t y,
+             py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> data) {
+            if (data.ndim() != 2) throw std::invalid_argument("data must be a 2-D [y, x] array");
+            const std::string why =
+                self.applyUpdate(x, y, data.shape(1), data.shape(0), data.data(),
+                                 static_cast<std::size_t>(data.size()));
+            if (!why.empty()) throw std::invalid_argument(why);
+          },
+          py::arg("x"), py::arg("y"), py::arg("data"),
+          "map_msgs/OccupancyGridUpdate: rewrites [x, x + w) x [y, y + h); ValueError (nothing "
+          "written) if the window is not inside the map.")
+      .def_property_readonly("has_map", &StaticMap::hasMap)
+      .def_property_readonly("geometry",
+                             [](const StaticMap& self) { return self.costs().geometry(); })
+      .def(
+          "costs",
+          [](const StaticMap& self) {
+            const GridGeometry& g = self.costs().geometry();
+            py::array_t<std::uint8_t> out({g.sizeY(), g.sizeX()});
+            std::copy(self.costs().cells().begin(), self.costs().cells().end(), out.mutable_data());
+            return out;
+          },
+          "[y, x] uint8 costs.")
+      .def_property_readonly(
+          "last_change",
+          [](const StaticMap& self) {
+            const CellBounds& b = self.lastChange();
+            return py::make_tuple(b.min_x, b.min_y, b.max_x, b.max_y);
+          },
+          "(min_x, min_y, max_x, max_y) cells, inclusive; min > max if nothing changed");
+
+  // ----------------------------------------------------------------- inflation
+  py::class_<InflationConfig>(m, "InflationConfig")
+      .def(py::init<>())
+      .def_readwrite("inflation_radius", &InflationConfig::inflation_radius, "m")
+      .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor, "1/m")
+      .def_readwrite("inscribed_radius", &InflationConfig::inscribed_radius, "m")
+      .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown)
+      .def_readonly_static("MAX_RADIUS_CELLS", &InflationConfig::kMaxRadiusCells,
+                           "largest inflation_radius / resolution accepted")
+      .def("validate", py::overload_cast<>(&InflationConfig::validate, py::const_))
+      .def("validate", py::overload_cast<double>(&InflationConfig::validate, py::const_),
+           py::arg("resolution_m"), "Also checks the radius in cells at this resolution.");
+  m.def("inflation_cost", &inflationCost, py::arg("distance_m"), py::arg("config"),
+        "costmap_2d's cost for a cell at distance_m from the nearest lethal cell.");
+  m.def(
+      "inflate",
+      [](py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast> costs,
+         double resolution, const InflationConfig& config) {
+        if (costs.ndim() != 2) throw std::invalid_argument("costs must be a 2-D [y, x] array");
+        const int h = static_cast<int>(costs.shape(0));
+        const int w = static_cast<int>(costs.shape(1));
+        Costmap master(GridGeometry(w, h, resolution, 0.0, 0.0), cost::kFreeSpace);
+        std::copy(costs.data(), costs.data() + costs.size(), master.data());
+        Inflator inflator(config, resolution);
+        CellBounds all;
+        all.expand(0, 0);
+        all.expand(w - 1, h - 1);
+        inflator.update(&master, all);
+        py::array_t<std::uint8_t> out({h, w});
+        std::copy(master.cells().begin(), master.cells().end(), out.mutable_data());
+        return out;
+      },
+      py::arg("costs"), py::arg("resolution"), py::arg("config"),
+      "Inflates a whole [y, x] uint8 cost grid (254 = lethal) and returns the merged grid.");
+  m.def(
+      "footprint_radii",
+      [](const std::vector<std::pair<double, double>>& points) {
+        Footprint polygon;
+        for (const auto& [x, y] : points) polygon.push_back({x, y});
+        const std::string why = validateFootprint(polygon);
+        if (!why.empty()) throw std::invalid_argument(why);
+        return std::make_pair(inscribedRadius(polygon), circumscribedRadius(polygon));
+      },
+      py::arg("points"), "(inscribed, circumscribed) radius of a footprint polygon, m.");
+  m.def(
+      "footprint_cells",
+      [](const std::vector<std::pair<double, double>>& points,
+         std::tuple<double, double, double> pose, const GridGeometry& geometry) {
+        Footprint polygon;
+        for (const auto& [x, y] : points) polygon.push_back({x, y});
+        const std::string why = validateFootprint(polygon);
+        if (!why.empty()) throw std::invalid_argument(why);
+        std::vector<std::size_t> cells;
+        polygonCells(transformFootprint(
+                         polygon, Pose2D{std::get<0>(pose), std::get<1>(pose), std::get<2>(pose)}),
+                     geometry, &cells);
+        py::array_t<bool> mask({geometry.sizeY(), geometry.sizeX()});
+        bool* m = mask.mutable_data();
+        std::fill(m, m + geometry.cellCount(), false);
+        for (const std::size_t i : cells) m[i] = true;
+        return mask;
+      },
+      py::arg("points"), py::arg("pose"), py::arg("geometry"),
+      "[y, x] bool mask of the cells whose centre lies inside the footprint placed at pose = "
+      "(x, y, yaw): the cells the obstacle layer clears under the robot.");
+}

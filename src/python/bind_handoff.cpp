@@ -1,0 +1,63 @@
+// Python bindings of the core's seam health: smear and the map <- odom correction monitor.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <stdexcept>
+
+#include "downstream_perception/core/costmap/cloud_beams.h"
+#include "downstream_perception/core/costmap/footprint.h"
+#include "downstream_perception/core/costmap/inflation.h"
+#include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/core/costmap/scan_integrator.h"
+#include "downstream_perception/core/costmap/static_map.h"
+#include "downstream_perception/core/grid/cost_values.h"
+#include "downstream_perception/core/grid/grid_geometry.h"
+#include "downstream_perception/core/grid/ray_traversal.h"
+#include "downstream_perception/core/grid/se2.h"
+#include "downstream_perception/core/handoff/seam_health.h"
+#include "downstream_perception/core/tracking/assignment.h"
+#include "downstream_perception/core/tracking/box.h"
+#include "downstream_perception/core/tracking/kalman.h"
+#include "downstream_perception/core/tracking/predicted_footprint.h"
+#include "downstream_perception/core/tracking/tracker.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;  // NOLINT
+
+void bindHandoff(py::module& m) {
+  // ----------------------------------------------------------------- seam health
+  m.def("expected_smear", &expectedSmear, py::arg("range_m"), py::arg("yaw_rate_rps"),
+        py::arg("age_s"), "range * tan(|yaw rate| * age): sideways throw of a late transform, m.");
+  py::class_<CorrectionMonitorConfig>(m, "CorrectionMonitorConfig")
+      .def(py::init<>())
+      .def_readwrite("window_s", &CorrectionMonitorConfig::window_s, "s")
+      .def_readwrite("reset_drop_m", &CorrectionMonitorConfig::reset_drop_m, "m")
+      .def_readwrite("max_correction_m", &CorrectionMonitorConfig::max_correction_m, "m")
+      .def_readwrite("zero_epsilon_m", &CorrectionMonitorConfig::zero_epsilon_m, "m")
+      .def_readwrite("min_travel_m", &CorrectionMonitorConfig::min_travel_m, "m")
+      .def_readwrite("ramp_m", &CorrectionMonitorConfig::ramp_m, "m")
+      .def("validate", &CorrectionMonitorConfig::validate);
+  py::class_<CorrectionMonitor>(m, "CorrectionMonitor", "Watches |map <- odom| over time.")
+      .def(py::init<const CorrectionMonitorConfig&>(),
+           py::arg("config") = CorrectionMonitorConfig())
+      .def("add", &CorrectionMonitor::add, py::arg("time_s"), py::arg("correction_m"),
+           py::arg("travelled_m"))
+      .def(
+          "add_many",
+          [](CorrectionMonitor& m, const Eigen::VectorXd& t, const Eigen::VectorXd& c,
+             const Eigen::VectorXd& d) {
+            if (t.size() != c.size() || t.size() != d.size()) {
+              throw std::invalid_argument("time_s, correction_m, travelled_m differ in length");
+            }
+            for (Eigen::Index i = 0; i < t.size(); ++i) m.add(t[i], c[i], d[i]);
+          },
+          py::arg("time_s"), py::arg("correction_m"), py::arg("travelled_m"))
+      .def_property_readonly("resets", &CorrectionMonitor::resets)
+      .def("never_resets", &CorrectionMonitor::neverResets)
+      .def("stuck_at_zero", &CorrectionMonitor::stuckAtZero)
+      .def("too_large", &CorrectionMonitor::tooLarge)
+      .def("findings", &CorrectionMonitor::findings);
+}

@@ -1,0 +1,336 @@
+// Python bindings of the core's detection geometry, assignment, Kalman, the tracker, predicted
+// footprints.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <stdexcept>
+
+#include "downstream_perception/core/costmap/cloud_beams.h"
+#include "downstream_perception/core/costmap/footprint.h"
+#include "downstream_perception/core/costmap/inflation.h"
+#include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/core/costmap/scan_integrator.h"
+#include "downstream_perception/core/costmap/static_map.h"
+#include "downstream_perception/core/grid/cost_values.h"
+#include "downstream_perception/core/grid/grid_geometry.h"
+#include "downstream_perception/core/grid/ray_traversal.h"
+#include "downstream_perception/core/grid/se2.h"
+#include "downstream_perception/core/handoff/seam_health.h"
+#include "downstream_perception/core/tracking/assignment.h"
+#include "downstream_perception/core/tracking/box.h"
+#include "downstream_perception/core/tracking/kalman.h"
+#include "downstream_perception/core/tracking/predicted_footprint.h"
+#include "downstream_perception/core/tracking/tracker.h"
+
+#include "numpy_arrays.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;          // NOLINT
+using namespace downstream_perception::python;  // NOLINT
+
+void bindTracking(py::module& m) {
+  // ----------------------------------------------------------------- detection and tracking
+  const auto toBox = [](py::array_t<double, py::array::c_style | py::array::forcecast> a,
+                        py::ssize_t row) {
+    const auto b = a.unchecked<2>();
+    return Box{b(row, 0), b(row, 1), b(row, 2), b(row, 3)};
+  };
+  const auto checkBoxes = [](const py::array& a, const char* name) {
+    if (a.ndim() != 2 || a.shape(1) != 4) {
+      throw std::invalid_argument(std::string(name) +
+                                  " must be an (N, 4) array of x_min, y_min, x_max, y_max");
+    }
+  };
+  m.def(
+      "iou",
+      [](std::tuple<double, double, double, double> a,
+         std::tuple<double, double, double, double> b) {
+        return iou({std::get<0>(a), std::get<1>(a), std::get<2>(a), std::get<3>(a)},
+                   {std::get<0>(b), std::get<1>(b), std::get<2>(b), std::get<3>(b)});
+      },
+      py::arg("a"), py::arg("b"), "IoU of two boxes (x_min, y_min, x_max, y_max).");
+  m.def(
+      "nms",
+      [toBox, checkBoxes](py::array_t<double, py::array::c_style | py::array::forcecast> boxes,
+                          py::array_t<double, py::array::c_style | py::array::forcecast> scores,
+                          double iou_threshold, std::optional<std::vector<int>> class_ids) {
+        checkBoxes(boxes, "boxes");
+        std::vector<Box> b;
+        for (py::ssize_t i = 0; i < boxes.shape(0); ++i) b.push_back(toBox(boxes, i));
+        const std::vector<double> s(scores.data(), scores.data() + scores.size());
+        const auto kept = nms(b, s, iou_threshold, class_ids ? &*class_ids : nullptr);
+        py::array_t<std::int64_t> out(static_cast<py::ssize_t>(kept.size()));
+        std::copy(kept.begin(), kept.end(), out.mutable_data());
+        return out;
+      },
+      py::arg("boxes"), py::arg("scores"), py::arg("iou_threshold") = 0.5,
+      py::arg("class_ids") = py::none(),
+      "Greedy NMS; returns the kept indices, best first. With class_ids, per class.");
+  m.def(
+      "mask_iou",
+      [](py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast> a,
+         py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast> b) {
+        if (a.size() != b.size()) throw std::invalid_argument("masks must have the same size");
+        return maskIou(a.data(), b.data(), static_cast<std::size_t>(a.size()));
+      },
+      py::arg("a"), py::arg("b"), "IoU of two binary masks (non-zero = foreground).");
+  // ----------------------------------------------------------------- predicted obstacles
+  py::class_<PredictionConfig>(m, "PredictionConfig")
+      .def(py::init<>())
+      .def_readwrite("prediction_horizon_s", &PredictionConfig::prediction_horizon_s, "s")
+      .def_readwrite("uncertainty_sigmas", &PredictionConfig::uncertainty_sigmas)
+      .def_readwrite("max_uncertainty_m", &PredictionConfig::max_uncertainty_m, "m")
+      .def_readwrite("min_object_size_m", &PredictionConfig::min_object_size_m, "m")
+      .def_readwrite("max_object_size_m", &PredictionConfig::max_object_size_m, "m")
+      .def_readwrite("max_speed_mps", &PredictionConfig::max_speed_mps, "m/s")
+      .def("validate", &PredictionConfig::validate);
+  py::class_<PlanarTrack>(m, "PlanarTrack", "One track in the costmap's frame.")
+      .def(py::init([](const Eigen::Vector2d& position, const Eigen::Vector2d& velocity,
+                       const Eigen::Matrix2d& position_covariance,
+                       const Eigen::Matrix2d& velocity_covariance, double size_x, double size_y,
+                       double box_yaw) {
+             PlanarTrack t;
+             t.position = position;
+             t.velocity = velocity;
+             t.position_covariance = position_covariance;
+             t.velocity_covariance = velocity_covariance;
+             t.size_x = size_x;
+             t.size_y = size_y;
+             t.box_yaw = box_yaw;
+             return t;
+           }),
+           py::arg("position"), py::arg("velocity"),
+           py::arg("position_covariance") = Eigen::Matrix2d::Zero().eval(),
+           py::arg("velocity_covariance") = Eigen::Matrix2d::Zero().eval(), py::arg("size_x") = 0.0,
+           py::arg("size_y") = 0.0, py::arg("box_yaw") = 0.0)
+      .def_readwrite("position", &PlanarTrack::position, "m")
+      .def_readwrite("velocity", &PlanarTrack::velocity, "m/s")
+      .def_readwrite("position_covariance", &PlanarTrack::position_covariance, "m^2")
+      .def_readwrite("velocity_covariance", &PlanarTrack::velocity_covariance, "m^2/s^2")
+      .def_readwrite("size_x", &PlanarTrack::size_x, "m")
+      .def_readwrite("size_y", &PlanarTrack::size_y, "m")
+      .def_readwrite("box_yaw", &PlanarTrack::box_yaw, "rad")
+      .def("validate", &PlanarTrack::validate);
+  m.def("uncertainty_radius", &uncertaintyRadius, py::arg("track"), py::arg("dt_s"),
+        py::arg("config"), "k sigma of the predicted position dt_s after the stamp, m (capped).");
+  m.def(
+      "swept_polygon",
+      [](const PlanarTrack& track, double duration_s, const PredictionConfig& config) {
+        const Footprint polygon = sweptPolygon(track, duration_s, config);
+        py::array_t<double> out({static_cast<py::ssize_t>(polygon.size()), py::ssize_t{2}});
+        auto a = out.mutable_unchecked<2>();
+        for (py::ssize_t i = 0; i < static_cast<py::ssize_t>(polygon.size()); ++i) {
+          a(i, 0) = polygon[i].x;
+          a(i, 1) = polygon[i].y;
+        }
+        return out;
+      },
+      py::arg("track"), py::arg("duration_s"), py::arg("config"),
+      "Convex polygon (N x 2, counter-clockwise) the box sweeps over duration_s.");
+  m.def(
+      "predicted_cells",
+      [](const PlanarTrack& track, double age_s, const PredictionConfig& config,
+         const GridGeometry& geometry) {
+        const std::string why = validatePrediction(track, age_s, config);
+        if (!why.empty()) throw std::invalid_argument(why);
+        std::vector<std::size_t> cells;
+        predictedCells(track, age_s, config, geometry, &cells);
+        std::vector<CellIndex> xy;
+        xy.reserve(cells.size());
+        for (const std::size_t i : cells) xy.push_back(geometry.cellOf(i));
+        return cellsToArray(xy);
+      },
+      py::arg("track"), py::arg("age_s"), py::arg("config"), py::arg("geometry"),
+      "Cells (N x 2 [x, y]) the track covers from its stamp over age_s + prediction_horizon_s. "
+      "Raises ValueError if the track, age_s or the config is invalid.");
+  m.def(
+      "recent_cells",
+      [](const PlanarTrack& track, double lookback_s, double age_s, double margin_m,
+         double max_object_size_m, const GridGeometry& geometry) {
+        const std::string why =
+            recentCellsReason(track, lookback_s, age_s, margin_m, max_object_size_m);
+        if (!why.empty()) throw std::invalid_argument(why);
+        std::vector<std::size_t> cells;
+        recentCells(track, lookback_s, age_s, margin_m, max_object_size_m, geometry, &cells);
+        std::vector<CellIndex> xy;
+        xy.reserve(cells.size());
+        for (const std::size_t i : cells) xy.push_back(geometry.cellOf(i));
+        return cellsToArray(xy);
+      },
+      py::arg("track"), py::arg("lookback_s"), py::arg("age_s"), py::arg("margin_m"),
+      py::arg("max_object_size_m"), py::arg("geometry"),
+      "Cells (N x 2 [x, y]) under the track's box grown by margin_m, swept from lookback_s before "
+      "its stamp to age_s after it (what clear_tracked_objects clears).");
+
+  m.def("chi_square_quantile", &chiSquareQuantile, py::arg("dof"), py::arg("confidence"),
+        "Squared-Mahalanobis gate: chi-square quantile (2, 0.99) -> 9.21.");
+  m.def(
+      "solve_assignment", [](const Eigen::MatrixXd& cost) { return solveAssignment(cost); },
+      py::arg("cost"),
+      "Min-cost assignment of rows to columns; inf = forbidden. Returns the column per row or -1.");
+
+  py::enum_<TrackState>(m, "TrackState")
+      .value("TENTATIVE", TrackState::kTentative)
+      .value("CONFIRMED", TrackState::kConfirmed)
+      .value("COASTING", TrackState::kCoasting);
+  py::class_<TrackerConfig> tc(m, "TrackerConfig");
+  py::enum_<TrackerConfig::Mode>(tc, "Mode")
+      .value("METRIC", TrackerConfig::Mode::kMetric)
+      .value("IMAGE", TrackerConfig::Mode::kImage);
+  tc.def(py::init<>())
+      .def_readonly_static("MAX_BOX_COORDINATE_PX", &TrackerConfig::kMaxBoxCoordinatePx,
+                           "image mode: larger |box coordinates| are rejected (out of range)")
+      .def_readonly_static("MAX_POSITION_M", &TrackerConfig::kMaxPositionM,
+                           "metric mode: larger |position| / size are rejected (out of range)")
+      .def_readwrite("mode", &TrackerConfig::mode)
+      .def_readwrite("gate_confidence", &TrackerConfig::gate_confidence)
+      .def_readwrite("duplicate_confidence", &TrackerConfig::duplicate_confidence)
+      .def_readwrite("reid_confidence", &TrackerConfig::reid_confidence)
+      .def_readwrite("min_iou", &TrackerConfig::min_iou)
+      .def_readwrite("accel_psd", &TrackerConfig::accel_psd)
+      .def_readwrite("measurement_std", &TrackerConfig::measurement_std)
+      .def_readwrite("initial_velocity_std", &TrackerConfig::initial_velocity_std)
+      .def_readwrite("min_hits", &TrackerConfig::min_hits)
+      .def_readwrite("max_age_s", &TrackerConfig::max_age_s)
+      .def_readwrite("high_score", &TrackerConfig::high_score)
+      .def_readwrite("low_score", &TrackerConfig::low_score)
+      .def_readwrite("second_pass", &TrackerConfig::second_pass)
+      .def_readwrite("class_aware", &TrackerConfig::class_aware)
+      .def("validate", &TrackerConfig::validate);
+  py::class_<TrackerStats>(m, "TrackerStats")
+      .def_readonly("detections", &TrackerStats::detections)
+      .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score)
+      .def_readonly("detections_rejected_invalid", &TrackerStats::detections_rejected_invalid)
+      .def_readonly("detections_rejected_out_of_range",
+                    &TrackerStats::detections_rejected_out_of_range)
+      .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass)
+      .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass)
+      .def_readonly("unmatched_outside_gate", &TrackerStats::unmatched_outside_gate)
+      .def_readonly("births", &TrackerStats::births)
+      .def_readonly("deaths", &TrackerStats::deaths)
+      .def_readonly("duplicates_removed", &TrackerStats::duplicates_removed)
+      .def_readonly("reidentified", &TrackerStats::reidentified)
+      .def_readonly("id_switches", &TrackerStats::id_switches)
+      .def_readonly("tracks", &TrackerStats::tracks)
+      .def_readonly("confirmed", &TrackerStats::confirmed);
+  py::class_<Tracker>(m, "Tracker",
+                      "SORT-style multi-object tracker (see core/tracking/tracker.h).")
+      .def(py::init<const TrackerConfig&>(), py::arg("config") = TrackerConfig{})
+      .def(
+          "step",
+          [](Tracker& self, double stamp,
+             py::array_t<double, py::array::c_style | py::array::forcecast> positions,
+             std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> scores,
+             std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> class_ids,
+             std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>
+                 covariances,
+             std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> truth_ids,
+             std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> sizes) {
+            const bool image = self.config().mode == TrackerConfig::Mode::kImage;
+            const py::ssize_t cols = image ? 4 : 2;
+            if (positions.ndim() != 2 || positions.shape(1) != cols) {
+              throw std::invalid_argument(image ? "boxes must be (N, 4)"
+                                                : "positions must be (N, 2)");
+            }
+            const py::ssize_t n = positions.shape(0);
+            const auto check = [n](const py::array& a, const char* name) {
+              if (a.shape(0) != n)
+                throw std::invalid_argument(std::string(name) + " must have N rows");
+            };
+            if (scores) check(*scores, "scores");
+            if (class_ids) check(*class_ids, "class_ids");
+            if (truth_ids) check(*truth_ids, "truth_ids");
+            if (covariances && (covariances->ndim() != 3 || covariances->shape(0) != n ||
+                                covariances->shape(1) != 2 || covariances->shape(2) != 2)) {
+              throw std::invalid_argument("covariances must be (N, 2, 2)");
+            }
+            if (sizes && image) {
+              throw std::invalid_argument("sizes are for metric mode (a box carries its size)");
+            }
+            if (sizes && (sizes->ndim() != 2 || sizes->shape(0) != n || sizes->shape(1) != 2)) {
+              throw std::invalid_argument("sizes must be (N, 2)");
+            }
+            std::vector<Detection> dets(n);
+            const auto p = positions.unchecked<2>();
+            for (py::ssize_t i = 0; i < n; ++i) {
+              Detection& d = dets[i];
+              if (image) {
+                d.box = {p(i, 0), p(i, 1), p(i, 2), p(i, 3)};
+              } else {
+                d.x = p(i, 0);
+                d.y = p(i, 1);
+              }
+              if (scores) d.score = scores->at(i);
+              if (class_ids) d.class_id = class_ids->at(i);
+              if (truth_ids) d.truth_id = truth_ids->at(i);
+              if (covariances) {
+                d.cov_xx = covariances->at(i, 0, 0);
+                d.cov_xy = covariances->at(i, 0, 1);
+                d.cov_yy = covariances->at(i, 1, 1);
+              }
+              if (sizes) {
+                d.size_x = sizes->at(i, 0);
+                d.size_y = sizes->at(i, 1);
+              }
+            }
+            py::gil_scoped_release release;
+            return self.step(stamp, dets);
+          },
+          py::arg("stamp"), py::arg("positions"), py::arg("scores") = py::none(),
+          py::arg("class_ids") = py::none(), py::arg("covariances") = py::none(),
+          py::arg("truth_ids") = py::none(), py::arg("sizes") = py::none(),
+          "One frame: positions (N, 2) in metres (metric mode) or boxes (N, 4) in pixels (image "
+          "mode); sizes (N, 2) in metres (metric mode only: tracks()['size']). Returns "
+          "TrackerStats.")
+      .def(
+          "tracks",
+          [](const Tracker& self, bool include_tentative) {
+            std::vector<Track> t;
+            for (const Track& track : self.tracks()) {
+              if (include_tentative || track.state != TrackState::kTentative) t.push_back(track);
+            }
+            const py::ssize_t n = static_cast<py::ssize_t>(t.size());
+            py::array_t<std::uint64_t> ids(n);
+            py::array_t<int> states(n), hits(n), truth(n);
+            py::array_t<double> pos({n, py::ssize_t{2}}), vel({n, py::ssize_t{2}}),
+                pos_cov({n, py::ssize_t{2}, py::ssize_t{2}}),
+                vel_cov({n, py::ssize_t{2}, py::ssize_t{2}}), size({n, py::ssize_t{2}});
+            for (py::ssize_t i = 0; i < n; ++i) {
+              ids.mutable_at(i) = t[i].id;
+              states.mutable_at(i) = static_cast<int>(t[i].state);
+              hits.mutable_at(i) = t[i].hits;
+              truth.mutable_at(i) = t[i].truth_id;
+              for (int k = 0; k < 2; ++k) {
+                pos.mutable_at(i, k) = t[i].position(k);
+                vel.mutable_at(i, k) = t[i].velocity(k);
+                for (int l = 0; l < 2; ++l) {
+                  pos_cov.mutable_at(i, k, l) = t[i].position_cov(k, l);
+                  vel_cov.mutable_at(i, k, l) = t[i].velocity_cov(k, l);
+                }
+              }
+              size.mutable_at(i, 0) = t[i].size_x;
+              size.mutable_at(i, 1) = t[i].size_y;
+            }
+            py::dict out;
+            out["id"] = ids;
+            out["state"] = states;
+            out["hits"] = hits;
+            out["truth_id"] = truth;
+            out["position"] = pos;
+            out["velocity"] = vel;
+            out["position_cov"] = pos_cov;
+            out["velocity_cov"] = vel_cov;
+            out["size"] = size;
+            return out;
+          },
+          py::arg("include_tentative") = true,
+          "Live tracks as a dict of numpy arrays (id, state, hits, truth_id, position, velocity, "
+          "position_cov, velocity_cov, size); state: 0 tentative, 1 confirmed, 2 coasting. "
+          "include_tentative=False leaves out the tracks not yet confirmed.")
+      .def("last_assignment", &Tracker::lastAssignment,
+           "Per detection of the last step: the id of the track that took it, or 0.")
+      .def("reset", &Tracker::reset);
+}

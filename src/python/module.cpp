@@ -1,0 +1,24 @@
+// The compiled core, downstream_perception._core: one binding function per capability
+// (bind_<capability>.cpp), called in an order that registers every type before a default
+// argument or another binding uses it.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+void bindTsdf(py::module& m);      // bind_tsdf.cpp
+void bindGrid(py::module& m);      // bind_grid.cpp
+void bindCostmap(py::module& m);   // bind_costmap.cpp
+void bindTracking(py::module& m);  // bind_tracking.cpp
+void bindHandoff(py::module& m);   // bind_handoff.cpp
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "downstream_perception ROS-free core (C++), with numpy arrays in and out.";
+  // The package refuses numpy 2 with a pybind11 older than 2.12 (see __init__.py).
+  m.attr("pybind11_version") = py::make_tuple(PYBIND11_VERSION_MAJOR, PYBIND11_VERSION_MINOR);
+  bindTsdf(m);
+
+  bindGrid(m);
+  bindCostmap(m);
+  bindTracking(m);
+  bindHandoff(m);
+}
