@@ -208,6 +208,7 @@ void bindTracking(py::module& m) {
                     &TrackerStats::detections_rejected_out_of_range)
       .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass)
       .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass)
+      .def_readonly("unmatched_outside_gate", &TrackerStats::unmatched_outside_gate)
       .def_readonly("births", &TrackerStats::births)
       .def_readonly("deaths", &TrackerStats::deaths)
       .def_readonly("duplicates_removed", &TrackerStats::duplicates_removed)
@@ -226,7 +227,8 @@ void bindTracking(py::module& m) {
              std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> class_ids,
              std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>
                  covariances,
-             std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> truth_ids) {
+             std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>> truth_ids,
+             std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> sizes) {
             const bool image = self.config().mode == TrackerConfig::Mode::kImage;
             const py::ssize_t cols = image ? 4 : 2;
             if (positions.ndim() != 2 || positions.shape(1) != cols) {
@@ -244,6 +246,12 @@ void bindTracking(py::module& m) {
             if (covariances && (covariances->ndim() != 3 || covariances->shape(0) != n ||
                                 covariances->shape(1) != 2 || covariances->shape(2) != 2)) {
               throw std::invalid_argument("covariances must be (N, 2, 2)");
+            }
+            if (sizes && image) {
+              throw std::invalid_argument("sizes are for metric mode (a box carries its size)");
+            }
+            if (sizes && (sizes->ndim() != 2 || sizes->shape(0) != n || sizes->shape(1) != 2)) {
+              throw std::invalid_argument("sizes must be (N, 2)");
             }
             std::vector<Detection> dets(n);
             const auto p = positions.unchecked<2>();
@@ -263,19 +271,27 @@ void bindTracking(py::module& m) {
                 d.cov_xy = covariances->at(i, 0, 1);
                 d.cov_yy = covariances->at(i, 1, 1);
               }
+              if (sizes) {
+                d.size_x = sizes->at(i, 0);
+                d.size_y = sizes->at(i, 1);
+              }
             }
             py::gil_scoped_release release;
             return self.step(stamp, dets);
           },
           py::arg("stamp"), py::arg("positions"), py::arg("scores") = py::none(),
           py::arg("class_ids") = py::none(), py::arg("covariances") = py::none(),
-          py::arg("truth_ids") = py::none(),
+          py::arg("truth_ids") = py::none(), py::arg("sizes") = py::none(),
           "One frame: positions (N, 2) in metres (metric mode) or boxes (N, 4) in pixels (image "
-          "mode). Returns TrackerStats.")
+          "mode); sizes (N, 2) in metres (metric mode only: tracks()['size']). Returns "
+          "TrackerStats.")
       .def(
           "tracks",
-          [](const Tracker& self) {
-            const auto& t = self.tracks();
+          [](const Tracker& self, bool include_tentative) {
+            std::vector<Track> t;
+            for (const Track& track : self.tracks()) {
+              if (include_tentative || track.state != TrackState::kTentative) t.push_back(track);
+            }
             const py::ssize_t n = static_cast<py::ssize_t>(t.size());
             py::array_t<std::uint64_t> ids(n);
             py::array_t<int> states(n), hits(n), truth(n);
@@ -310,8 +326,10 @@ void bindTracking(py::module& m) {
             out["size"] = size;
             return out;
           },
+          py::arg("include_tentative") = true,
           "Live tracks as a dict of numpy arrays (id, state, hits, truth_id, position, velocity, "
-          "position_cov, velocity_cov, size); state: 0 tentative, 1 confirmed, 2 coasting.")
+          "position_cov, velocity_cov, size); state: 0 tentative, 1 confirmed, 2 coasting. "
+          "include_tentative=False leaves out the tracks not yet confirmed.")
       .def("last_assignment", &Tracker::lastAssignment,
            "Per detection of the last step: the id of the track that took it, or 0.")
       .def("reset", &Tracker::reset);

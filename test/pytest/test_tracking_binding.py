@@ -126,3 +126,36 @@ def test_tracker_counts_out_of_range_and_negative_detections() -> None:
     stats = metric.step(0.0, np.array([[1e30, 0.0], [1.0, 2.0], [too_far, 0.0]]))
     assert stats.detections_rejected_out_of_range == 2
     assert len(metric.tracks()["id"]) == 1
+
+
+def test_tracker_carries_metric_sizes_and_counts_unmatched_detections() -> None:
+    # Issue 21 defect 5: step() had no sizes argument, so tracks()["size"] was always 0 in
+    # metric mode although the C++ detection carries a size; item 7: unmatched_outside_gate.
+    config = dp.TrackerConfig()
+    config.min_hits = 1
+    tracker = dp.Tracker(config)
+    positions = np.array([[0.0, 0.0], [10.0, 0.0]])
+    sizes = np.array([[0.6, 0.4], [4.5, 1.8]])
+    stats = tracker.step(0.0, positions, sizes=sizes)
+    assert stats.unmatched_outside_gate == 2  # no track yet: both start one
+    stats = tracker.step(0.1, positions + 0.05, sizes=sizes * 1.1)
+    assert stats.unmatched_outside_gate == 0
+    np.testing.assert_allclose(tracker.tracks()["size"], sizes * 1.1)
+    with pytest.raises(ValueError):
+        tracker.step(0.2, positions, sizes=sizes[:1])
+    image = dp.TrackerConfig()
+    image.mode = dp.TrackerConfig.Mode.IMAGE
+    with pytest.raises(ValueError):  # a box carries its size
+        dp.Tracker(image).step(0.0, np.array([[0.0, 0.0, 10.0, 10.0]]), sizes=np.ones((1, 2)))
+
+
+def test_tracks_can_leave_out_tentative_tracks() -> None:
+    # Issue 21 item 7: a consumer that reports only established tracks filtered by hand.
+    tracker = dp.Tracker(dp.TrackerConfig())  # min_hits 3: one detection is a tentative track
+    tracker.step(0.0, np.array([[0.0, 0.0]]))
+    assert tracker.tracks()["state"].tolist() == [0]
+    established = tracker.tracks(include_tentative=False)
+    assert established["id"].shape == (0,) and established["position"].shape == (0, 2)
+    for k in (1, 2):
+        tracker.step(0.1 * k, np.array([[0.0, 0.0]]))
+    assert tracker.tracks(include_tentative=False)["state"].tolist() == [1]

@@ -62,6 +62,11 @@ namespace {
 /// Smallest width / height (px) a coasting image box keeps (its size has a velocity too).
 constexpr double kMinBoxSizePx = 1.0;
 
+/// Slack (s) on max_age_s: a limit of k frame periods (k / fps) and the age of k frames differ
+/// in the last bits (and a ROS stamp near 1.7e9 s is only exact to about 2e-7 s), so without it
+/// a track died one frame early for some k. Far below any frame period.
+constexpr double kAgeToleranceS = 1e-6;
+
 enum class Verdict { kOk, kInvalid, kOutOfRange };
 
 Verdict checkDetection(const Detection& d, TrackerConfig::Mode mode) {
@@ -333,7 +338,8 @@ struct Core : Tracker::Impl {
     for (std::size_t a = 0; a < tracks.size(); ++a) {
       if ((*gone)[a] || tracks[a].state != TrackState::kCoasting) continue;
       for (std::size_t b = 0; b < tracks.size(); ++b) {
-        if ((*gone)[b] || tracks[b].state == TrackState::kTentative) continue;
+        // b == a: a coasting track updated at this very stamp passes every test below.
+        if (b == a || (*gone)[b] || tracks[b].state == TrackState::kTentative) continue;
         if (states[b].last_update_s != now || states[b].birth_s < states[a].last_update_s) {
           continue;
         }
@@ -378,22 +384,52 @@ struct Core : Tracker::Impl {
     track.time_since_update_s = now - s.last_update_s;
   }
 
+  /// This frame's detections as the filters see them, and who took which.
+  struct Frame {
+    std::vector<Vec> z;                  ///< measurement per detection
+    std::vector<Mat> R;                  ///< its noise
+    std::vector<std::size_t> high;       ///< accepted detections at or above high_score
+    std::vector<std::size_t> low;        ///< accepted detections for the second pass only
+    std::vector<int> det_of_track;       ///< per track: its detection's index, -1 if none
+    std::vector<int> track_of_det;       ///< per detection: its track's index, -1 if none
+    std::vector<std::size_t> newcomers;  ///< tracks confirmed this frame
+  };
+
   TrackerStats step(double now, const std::vector<Detection>& detections) override {
+    const double dt = advanceClock(now);
+    TrackerStats stats;
+    stats.detections = detections.size();
+    predictAll(dt);
+    Frame frame = acceptDetections(detections, &stats);
+    associateAll(detections, &frame, &stats);
+    updateOrRetireTracks(detections, now, &frame, &stats);
+    mergeReturningTracks(frame.newcomers, now, &stats);
+    bearTracks(detections, now, frame, &stats);
+    publish(detections.size(), now, &stats);
+    return stats;
+  }
+
+  // Checks the stamp and returns the time since the previous frame (0 on the first). One stamp
+  // is one frame: a repeated stamp would be a frame with dt = 0, in which a lost track misses
+  // again without ageing (it never died), so it is refused like an older one.
+  double advanceClock(double now) {
     if (!(std::abs(now) <= TrackerConfig::kMaxStampS)) {
       throw std::invalid_argument("tracker: stamp must be finite and within 1e10 s, got " +
                                   std::to_string(now));
     }
-    if (started && now < last_stamp) {
-      throw std::invalid_argument("tracker: stamp " + std::to_string(now) +
-                                  " s is older than the previous frame's " +
-                                  std::to_string(last_stamp) + " s");
+    if (started && now <= last_stamp) {
+      throw std::invalid_argument("tracker: stamp " + std::to_string(now) + " s is " +
+                                  (now == last_stamp ? "the previous frame's (one stamp, one frame)"
+                                                     : "older than the previous frame's " +
+                                                           std::to_string(last_stamp) + " s"));
     }
     const double dt = started ? now - last_stamp : 0.0;
     started = true;
     last_stamp = now;
-    TrackerStats stats;
-    stats.detections = detections.size();
+    return dt;
+  }
 
+  void predictAll(double dt) {
     for (State& s : states) {
       s.detection = -1;
       s.filter.predict(dt, processNoise(s));
@@ -403,106 +439,140 @@ struct Core : Tracker::Impl {
         s.filter.clampPositionBelow(3, kMinBoxSizePx);
       }
     }
+  }
 
-    // Split detections by score; measurements once per detection.
-    std::vector<Vec> z(detections.size());
-    std::vector<Mat> R(detections.size());
-    std::vector<std::size_t> high, low;
+  // Refuses invalid detections, splits the rest by score; measurements once per detection.
+  Frame acceptDetections(const std::vector<Detection>& detections, TrackerStats* stats) const {
+    Frame frame;
+    frame.z.resize(detections.size());
+    frame.R.resize(detections.size());
     for (std::size_t j = 0; j < detections.size(); ++j) {
       const Detection& d = detections[j];
       const Verdict verdict = checkDetection(d, config.mode);
       if (verdict != Verdict::kOk) {
-        ++(verdict == Verdict::kInvalid ? stats.detections_rejected_invalid
-                                        : stats.detections_rejected_out_of_range);
+        ++(verdict == Verdict::kInvalid ? stats->detections_rejected_invalid
+                                        : stats->detections_rejected_out_of_range);
         continue;
       }
       if (d.score < config.low_score || (d.score < config.high_score && !config.second_pass)) {
-        ++stats.detections_ignored_low_score;
+        ++stats->detections_ignored_low_score;
         continue;
       }
-      measurement(d, &z[j], &R[j]);
-      (d.score >= config.high_score ? high : low).push_back(j);
+      measurement(d, &frame.z[j], &frame.R[j]);
+      (d.score >= config.high_score ? frame.high : frame.low).push_back(j);
     }
+    return frame;
+  }
 
-    std::vector<int> det_of_track(tracks.size(), -1);
-    std::vector<int> track_of_det(detections.size(), -1);
+  // High-score detections go to established tracks, then to tentative ones; low-score ones
+  // (second pass) only continue established tracks.
+  void associateAll(const std::vector<Detection>& detections, Frame* frame, TrackerStats* stats) {
+    frame->det_of_track.assign(tracks.size(), -1);
+    frame->track_of_det.assign(detections.size(), -1);
+    const auto pass = [&](const std::vector<std::size_t>& cands,
+                          const std::vector<std::size_t>& dets) {
+      return associate(cands, dets, detections, frame->z, frame->R, &frame->det_of_track,
+                       &frame->track_of_det);
+    };
     // Established tracks choose first, so a tentative duplicate (born from one detection that
     // fell outside a coasting track's gate) cannot take the object's next detection from it.
     std::vector<std::size_t> established, tentative;
     for (std::size_t t = 0; t < tracks.size(); ++t) {
       (tracks[t].state == TrackState::kTentative ? tentative : established).push_back(t);
     }
-    stats.matched_first_pass =
-        associate(established, high, detections, z, R, &det_of_track, &track_of_det);
+    stats->matched_first_pass = pass(established, frame->high);
     std::vector<std::size_t> high_left;
-    for (const std::size_t j : high) {
-      if (track_of_det[j] < 0) high_left.push_back(j);
+    for (const std::size_t j : frame->high) {
+      if (frame->track_of_det[j] < 0) high_left.push_back(j);
     }
-    stats.matched_first_pass +=
-        associate(tentative, high_left, detections, z, R, &det_of_track, &track_of_det);
-    if (config.second_pass && !low.empty()) {
-      // Low-score detections may only continue established tracks.
+    stats->matched_first_pass += pass(tentative, high_left);
+    if (config.second_pass && !frame->low.empty()) {
       std::vector<std::size_t> rest;
       for (std::size_t t = 0; t < tracks.size(); ++t) {
-        if (det_of_track[t] < 0 && tracks[t].state != TrackState::kTentative) rest.push_back(t);
+        if (frame->det_of_track[t] < 0 && tracks[t].state != TrackState::kTentative) {
+          rest.push_back(t);
+        }
       }
-      stats.matched_second_pass =
-          associate(rest, low, detections, z, R, &det_of_track, &track_of_det);
+      stats->matched_second_pass = pass(rest, frame->low);
     }
+  }
 
-    // Updates, coasting, deaths.
+  // Matched tracks take their detection; unmatched ones coast or die (and are dropped). Fills
+  // frame->newcomers with the indices, after the drop, of the tracks confirmed this frame.
+  void updateOrRetireTracks(const std::vector<Detection>& detections, double now, Frame* frame,
+                            TrackerStats* stats) {
     std::vector<Track> kept_tracks;
     std::vector<State> kept_states;
-    kept_tracks.reserve(tracks.size() + high.size());
-    kept_states.reserve(tracks.size() + high.size());
-    std::vector<std::size_t> newcomers;  // confirmed this frame (indices into kept_tracks)
+    kept_tracks.reserve(tracks.size() + frame->high.size());
+    kept_states.reserve(tracks.size() + frame->high.size());
     for (std::size_t t = 0; t < tracks.size(); ++t) {
-      Track& track = tracks[t];
-      State& s = states[t];
-      const int j = det_of_track[t];
+      const int j = frame->det_of_track[t];
       if (j >= 0) {
-        const Detection& d = detections[j];
-        s.filter.update(z[j], R[j]);
-        s.last_update_s = now;
-        s.detection = j;
-        ++track.hits;
-        track.score = d.score;
-        if constexpr (D == 2) {
-          track.size_x = d.size_x;
-          track.size_y = d.size_y;
+        if (updateMatched(&tracks[t], &states[t], detections[j], j, *frame, now)) {
+          frame->newcomers.push_back(kept_tracks.size());
         }
-        if (track.class_id < 0) track.class_id = d.class_id;
-        if (track.state == TrackState::kTentative && track.hits >= config.min_hits) {
-          newcomers.push_back(kept_tracks.size());
-          track.state = TrackState::kConfirmed;
-        } else if (track.state == TrackState::kCoasting) {
-          track.state = TrackState::kConfirmed;
-        }
-        track.truth_id = d.truth_id;
-      } else if (track.state == TrackState::kTentative ||
-                 now - s.last_update_s > config.max_age_s) {
-        ++stats.deaths;
+      } else if (!survivesMiss(&tracks[t], states[t], now)) {
+        ++stats->deaths;
         continue;
-      } else {
-        track.state = TrackState::kCoasting;
       }
-      kept_tracks.push_back(track);
-      kept_states.push_back(s);
+      kept_tracks.push_back(tracks[t]);
+      kept_states.push_back(states[t]);
     }
     tracks.swap(kept_tracks);
     states.swap(kept_states);
+  }
+
+  // Updates a track with detection j; true if this confirms it.
+  bool updateMatched(Track* track, State* s, const Detection& d, int j, const Frame& frame,
+                     double now) const {
+    s->filter.update(frame.z[j], frame.R[j]);
+    s->last_update_s = now;
+    s->detection = j;
+    ++track->hits;
+    track->score = d.score;
+    if constexpr (D == 2) {
+      track->size_x = d.size_x;
+      track->size_y = d.size_y;
+    }
+    if (track->class_id < 0) track->class_id = d.class_id;
+    track->truth_id = d.truth_id;
+    if (track->state == TrackState::kTentative && track->hits >= config.min_hits) {
+      track->state = TrackState::kConfirmed;
+      return true;
+    }
+    if (track->state == TrackState::kCoasting) track->state = TrackState::kConfirmed;
+    return false;
+  }
+
+  // A track without a detection this frame: false if it dies (tentative, or coasted too long),
+  // else it coasts.
+  bool survivesMiss(Track* track, const State& s, double now) const {
+    if (track->state == TrackState::kTentative ||
+        now - s.last_update_s > config.max_age_s + kAgeToleranceS) {
+      return false;
+    }
+    track->state = TrackState::kCoasting;
+    return true;
+  }
+
+  // Metric mode: re-identification of tracks confirmed this frame, then duplicate removal.
+  void mergeReturningTracks(const std::vector<std::size_t>& newcomers, double now,
+                            TrackerStats* stats) {
     if constexpr (D == 2) {
       std::vector<char> gone(tracks.size(), 0);
-      stats.reidentified = reidentify(newcomers, &gone);
-      stats.duplicates_removed = removeDuplicates(&gone, now);
+      stats->reidentified = reidentify(newcomers, &gone);
+      stats->duplicates_removed = removeDuplicates(&gone, now);
       compact(gone);
     }
-    stats.deaths += stats.duplicates_removed;
+    stats->deaths += stats->duplicates_removed;
+  }
 
-    // Births from unmatched high-score detections.
-    for (const std::size_t j : high) {
-      if (track_of_det[j] >= 0) continue;
-      ++stats.unmatched_outside_gate;
+  // Births from high-score detections no track took.
+  void bearTracks(const std::vector<Detection>& detections, double now, const Frame& frame,
+                  TrackerStats* stats) {
+    for (const std::size_t j : frame.high) {
+      if (frame.track_of_det[j] >= 0) continue;
+      ++stats->unmatched_outside_gate;
       const Detection& d = detections[j];
       Track track;
       track.id = next_id++;
@@ -515,24 +585,27 @@ struct Core : Tracker::Impl {
       track.size_y = d.size_y;
       double velocity_std = config.initial_velocity_std;
       if constexpr (D == 4) velocity_std *= d.box.height();
-      State s{Filter(z[j], R[j], velocity_std), now, now};
+      State s{Filter(frame.z[j], frame.R[j], velocity_std), now, now};
       s.detection = static_cast<int>(j);
       tracks.push_back(track);
       states.push_back(s);
-      ++stats.births;
+      ++stats->births;
     }
-    // Ids are final now (re-identification may have changed some).
-    assignment.assign(detections.size(), 0);
+  }
+
+  // The assignment (ids are final now: re-identification may have changed some), truth
+  // bookkeeping, the public track fields and the counts.
+  void publish(std::size_t detection_count, double now, TrackerStats* stats) {
+    assignment.assign(detection_count, 0);
     for (std::size_t t = 0; t < tracks.size(); ++t) {
       const int j = states[t].detection;
       if (j < 0) continue;
       assignment[j] = tracks[t].id;
-      noteTruth(tracks[t], &stats);
+      noteTruth(tracks[t], stats);
     }
     for (std::size_t t = 0; t < tracks.size(); ++t) refresh(t, now);
-    stats.tracks = tracks.size();
-    for (const Track& t : tracks) stats.confirmed += t.state != TrackState::kTentative;
-    return stats;
+    stats->tracks = tracks.size();
+    for (const Track& t : tracks) stats->confirmed += t.state != TrackState::kTentative;
   }
 };
 

@@ -190,7 +190,7 @@ void TrackerRos::onDetections(const DetectedObjectArrayConstPtr& msg) {
     try {
       last_ = tracker_->step(msg->header.stamp.toSec(), detections);
     } catch (const std::invalid_argument& e) {
-      rejected_.count("bad message: stamp older than the previous frame");
+      rejected_.count("bad message: stamp not newer than the previous frame");
       ROS_WARN_THROTTLE(2.0, "tracker: %s", e.what());
       return;
     }

@@ -139,9 +139,10 @@ class Tracker {
   Tracker(Tracker&&) noexcept;
   Tracker& operator=(Tracker&&) noexcept;
 
-  /// One frame at time `stamp_s` (s, monotonic; an older stamp than the last is rejected with
-  /// std::invalid_argument). Predicts every track to the stamp, associates, updates, manages
-  /// births and deaths. Returns this frame's statistics.
+  /// One frame at time `stamp_s` (s, strictly increasing: one stamp is one frame, so a stamp
+  /// equal to or older than the last is rejected with std::invalid_argument and changes
+  /// nothing; merge the detections of one instant into one call). Predicts every track to the
+  /// stamp, associates, updates, manages births and deaths. Returns this frame's statistics.
   TrackerStats step(double stamp_s, const std::vector<Detection>& detections);
   /// Every live track (tentative, confirmed, coasting), oldest first.
   const std::vector<Track>& tracks() const;
