@@ -31,8 +31,10 @@ namespace py = pybind11;
 using namespace downstream_perception;          // NOLINT
 using namespace downstream_perception::python;  // NOLINT
 
-void bindCostmap(py::module& m) {
-  // ----------------------------------------------------------------- log-odds grid
+namespace {
+
+// LogOddsConfig, LogOddsGrid and the probability conversions.
+void bindLogOddsGrid(py::module& m) {
   py::class_<LogOddsConfig>(m, "LogOddsConfig")
       .def(py::init<>())
       .def_readwrite("p_hit", &LogOddsConfig::p_hit)
@@ -128,8 +130,10 @@ void bindCostmap(py::module& m) {
 
   m.def("log_odds_of", &LogOddsGrid::logOddsOf, "log(p / (1 - p))");
   m.def("probability_of", &LogOddsGrid::probabilityOf, "1 - 1 / (1 + exp(l))");
+}
 
-  // ----------------------------------------------------------------- scan integration
+// Scans and clouds into a log-odds grid: ScanIntegrator with its config and stats.
+void bindScanIntegration(py::module& m) {
   py::class_<ScanIntegratorConfig>(m, "ScanIntegratorConfig")
       .def(py::init<>())
       .def_readwrite("marking", &ScanIntegratorConfig::marking)
@@ -244,8 +248,10 @@ void bindCostmap(py::module& m) {
           "Integrates an (N, 3) point cloud in the sensor frame placed by the 4 x 4 transform "
           "grid_from_sensor; points outside the height band (grid frame z, m) are skipped; with "
           "merge_cells one beam per grid cell (the first point in it).");
+}
 
-  // ----------------------------------------------------------------- static map
+// The static map layer and its occupancy-grid conversion.
+void bindStaticMap(py::module& m) {
   py::class_<StaticMapConfig>(m, "StaticMapConfig")
       .def(py::init<>())
       .def_readwrite("track_unknown_space", &StaticMapConfig::track_unknown_space)
@@ -323,8 +329,10 @@ void bindCostmap(py::module& m) {
             return py::make_tuple(b.min_x, b.min_y, b.max_x, b.max_y);
           },
           "(min_x, min_y, max_x, max_y) cells, inclusive; min > max if nothing changed");
+}
 
-  // ----------------------------------------------------------------- inflation
+// Inflation (cost, inflate) and the footprint helpers.
+void bindInflationAndFootprint(py::module& m) {
   py::class_<InflationConfig>(m, "InflationConfig")
       .def(py::init<>())
       .def_readwrite("inflation_radius", &InflationConfig::inflation_radius, "m")
@@ -389,4 +397,13 @@ void bindCostmap(py::module& m) {
       py::arg("points"), py::arg("pose"), py::arg("geometry"),
       "[y, x] bool mask of the cells whose centre lies inside the footprint placed at pose = "
       "(x, y, yaw): the cells the obstacle layer clears under the robot.");
+}
+
+}  // namespace
+
+void bindCostmap(py::module& m) {
+  bindLogOddsGrid(m);
+  bindScanIntegration(m);
+  bindStaticMap(m);
+  bindInflationAndFootprint(m);
 }
