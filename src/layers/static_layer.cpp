@@ -1,7 +1,5 @@
 #include "downstream_perception/layers/static_layer.h"
 
-#include <tf2/LinearMath/Matrix3x3.h>
-#include <tf2/LinearMath/Quaternion.h>
 #include <tf2_ros/buffer.h>
 #include <pluginlib/class_list_macros.hpp>
 
@@ -10,6 +8,7 @@
 
 #include "downstream_perception/core/grid/cost_values.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/param_reader.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
 
@@ -229,9 +228,8 @@ bool StaticLayer::lookUpTransform() {
     try {
       // costmap_2d's lookup: map frame <- global frame, latest, applied to points at z = 0.
       const auto s = tf_->lookupTransform(map_frame_, global_frame, ros::Time(0));
-      const auto& q = s.transform.rotation;
-      const tf2::Matrix3x3 r(tf2::Quaternion(q.x, q.y, q.z, q.w));
-      t.xx = r[0][0], t.xy = r[0][1], t.yx = r[1][0], t.yy = r[1][1];
+      const Eigen::Matrix3d r = rotationOf(s.transform.rotation);
+      t.xx = r(0, 0), t.xy = r(0, 1), t.yx = r(1, 0), t.yy = r(1, 1);
       t.tx = s.transform.translation.x, t.ty = s.transform.translation.y;
     } catch (const tf2::TransformException& e) {
       ++tf_failures_;

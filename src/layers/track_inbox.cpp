@@ -1,7 +1,5 @@
 #include "downstream_perception/layers/track_inbox.h"
 
-#include <tf2/utils.h>
-
 #include <sstream>
 
 #include "downstream_perception/ros/common/config_errors.h"
@@ -80,7 +78,7 @@ void TrackInbox::onTracks(const TrackedObjectArrayConstPtr& msg) {
     return;
   }
   const TrackInboxConfig c = config();
-  const double box_yaw = tf2::getYaw(transform.transform.rotation);
+  const double box_yaw = yawOf(transform.transform.rotation);
   std::vector<PlanarTrack> tracks;
   std::size_t skipped_state = 0;
   for (const TrackedObject& object : msg->tracks) {

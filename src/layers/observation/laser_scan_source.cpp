@@ -1,9 +1,7 @@
 #include "downstream_perception/layers/observation/laser_scan_source.h"
 
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
-
-#include <tf2/LinearMath/Matrix3x3.h>
-#include <tf2/LinearMath/Quaternion.h>
 
 #include <algorithm>
 #include <cmath>
@@ -40,25 +38,24 @@ bool LaserScanSource::sensorPose(const std::string& frame, const ros::Time& stam
                                  ScanHeightModel* heights) {
   geometry_msgs::TransformStamped t;
   if (!lookup(frame, stamp, &t, reject_on_failure)) return false;
-  const auto& q = t.transform.rotation;
-  const tf2::Matrix3x3 r(tf2::Quaternion(q.x, q.y, q.z, q.w));
+  const Eigen::Matrix3d r = rotationOf(t.transform.rotation);
   // The scan plane's normal must be (anti)parallel to the global z axis.
-  if (std::abs(r[2][2]) < std::cos(kMaxTiltRad)) {
+  if (std::abs(r(2, 2)) < std::cos(kMaxTiltRad)) {
     std::ostringstream s;
     s << "sensor frame '" << frame << "' is tilted "
-      << std::acos(std::min(1.0, std::abs(r[2][2]))) * 180.0 / M_PI
+      << std::acos(std::min(1.0, std::abs(r(2, 2)))) * 180.0 / M_PI
       << " deg from horizontal (limit " << kMaxTiltRad * 180.0 / M_PI << " deg)";
     reject("bad pose: sensor tilted", s.str());
     return false;
   }
   pose->x = t.transform.translation.x;
   pose->y = t.transform.translation.y;
-  pose->yaw = std::atan2(r[1][0], r[0][0]);
-  *upside_down = r[2][2] < 0.0;
+  pose->yaw = std::atan2(r(1, 0), r(0, 0));
+  *upside_down = r(2, 2) < 0.0;
   if (heights != nullptr) {
     heights->origin_z = t.transform.translation.z;
-    heights->zx = r[2][0];
-    heights->zy = r[2][1];
+    heights->zx = r(2, 0);
+    heights->zy = r(2, 1);
   }
   return true;
 }

@@ -7,11 +7,13 @@
 
 namespace downstream_perception {
 
+Eigen::Matrix3d rotationOf(const geometry_msgs::Quaternion& q) {
+  return Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+}
+
 Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
+  T.linear() = rotationOf(t.rotation);
   T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
   return T;
 }

@@ -1,13 +1,13 @@
 #include "downstream_perception/ros/costmap/costmap_ros.h"
 
 #include <geometry_msgs/PolygonStamped.h>
-#include <tf2/utils.h>
 
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/costmap/costmap_plugin_list.h"
 #include "downstream_perception/ros/costmap/footprint_params.h"
 
@@ -244,7 +244,7 @@ bool CostmapRos::robotPose(double* x, double* y, double* yaw) {
     }
     *x = t.transform.translation.x;
     *y = t.transform.translation.y;
-    *yaw = tf2::getYaw(t.transform.rotation);
+    *yaw = yawOf(t.transform.rotation);
     return true;
   } catch (const tf2::TransformException& e) {
     last_pose_error_ = e.what();

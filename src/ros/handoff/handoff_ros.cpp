@@ -1,12 +1,12 @@
 #include "downstream_perception/ros/handoff/handoff_ros.h"
 
-#include <tf2/utils.h>
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>  // PoseStamped in tf2_ros::Buffer::transform
 
 #include <cmath>
 
 #include "downstream_perception/core/grid/se2.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 
 namespace downstream_perception {
@@ -146,9 +146,8 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
     if (!moving) {
       have_rate = true;
     } else if (dt > 0.0) {
-      yaw_rate = shortestAngularDistance(tf2::getYaw(a.transform.rotation),
-                                         tf2::getYaw(b.transform.rotation)) /
-                 dt;
+      yaw_rate =
+          shortestAngularDistance(yawOf(a.transform.rotation), yawOf(b.transform.rotation)) / dt;
       have_rate = true;
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -178,7 +177,7 @@ void HandoffRos::onTimer(const ros::TimerEvent&) {
     if (have_correction) {
       health.map_odom_correction_m =
           std::hypot(map_odom.transform.translation.x, map_odom.transform.translation.y);
-      health.map_odom_correction_yaw_rad = tf2::getYaw(map_odom.transform.rotation);
+      health.map_odom_correction_yaw_rad = yawOf(map_odom.transform.rotation);
       // A static map <- odom (stamp 0) has no age.
       health.map_odom_pose_age_s =
           map_odom.header.stamp.isZero() ? -1.0 : (now - map_odom.header.stamp).toSec();

@@ -42,6 +42,30 @@ TEST(Conversions, YawOfAQuaternion) {
   EXPECT_NEAR(yawOf(yawQuaternion(-2.0)), -2.0, kEps);
 }
 
+TEST(Conversions, RotationOfANearlyUnitQuaternionIsARotation) {
+  // 90 deg about z, scaled by 1.01 (a message's quaternion is only nearly unit): x -> y exactly,
+  // and the matrix stays orthonormal (tf2::Matrix3x3 and Eigen both normalize; we rely on it).
+  geometry_msgs::Quaternion q = yawQuaternion(M_PI / 2.0);
+  q.z *= 1.01;
+  q.w *= 1.01;
+  const Eigen::Matrix3d r = rotationOf(q);
+  EXPECT_NEAR(r(0, 0), 0.0, kEps);
+  EXPECT_NEAR(r(1, 0), 1.0, kEps);
+  EXPECT_NEAR(r(2, 2), 1.0, kEps);
+  EXPECT_NEAR((r * r.transpose() - Eigen::Matrix3d::Identity()).norm(), 0.0, kEps);
+}
+
+TEST(Conversions, RotationOfARollTiltsTheZAxis) {
+  // 180 deg about x (a scanner mounted upside down): z -> -z, the test the scan source uses.
+  geometry_msgs::Quaternion q;
+  q.x = 1.0;
+  q.w = 0.0;
+  const Eigen::Matrix3d r = rotationOf(q);
+  EXPECT_NEAR(r(2, 2), -1.0, kEps);
+  EXPECT_NEAR(r(1, 1), -1.0, kEps);
+  EXPECT_NEAR(r(0, 0), 1.0, kEps);
+}
+
 TEST(Conversions, TransformRoundTripsThroughEigen) {
   geometry_msgs::Transform t;
   t.translation.x = 1.5;

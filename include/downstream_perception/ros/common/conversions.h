@@ -24,6 +24,8 @@ Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t);
 /// The message of `T` (its rotation as a unit quaternion).
 geometry_msgs::Transform toTransformMsg(const Eigen::Isometry3d& T);
 
+/// The rotation matrix of `q` (normalized first: a message's quaternion is only nearly unit).
+Eigen::Matrix3d rotationOf(const geometry_msgs::Quaternion& q);
 /// Rotation about z of `q` (rad, in (-pi, pi]): the heading of a frame in the plane.
 double yawOf(const geometry_msgs::Quaternion& q);
 /// The plane's rotation by `yaw_rad`.
