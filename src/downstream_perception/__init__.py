@@ -67,6 +67,7 @@ try:
         PredictionConfig,
         ScanIntegrator,
         ScanIntegratorConfig,
+        SeamLimits,
         StaticMap,
         StaticMapConfig,
         Tracker,

@@ -31,6 +31,12 @@ void bindHandoff(py::module& m) {
   // ----------------------------------------------------------------- seam health
   m.def("expected_smear", &expectedSmear, py::arg("range_m"), py::arg("yaw_rate_rps"),
         py::arg("age_s"), "range * tan(|yaw rate| * age): sideways throw of a late transform, m.");
+  py::class_<SeamLimits>(m, "SeamLimits", "The seam health's warning limits (handoff keys).")
+      .def(py::init<>())
+      .def_readwrite("reference_range_m", &SeamLimits::reference_range_m, "m")
+      .def_readwrite("max_transform_age_s", &SeamLimits::max_transform_age_s, "s")
+      .def_readwrite("max_smear_m", &SeamLimits::max_smear_m, "m")
+      .def_readwrite("max_map_odom_age_s", &SeamLimits::max_map_odom_age_s, "s");
   py::class_<CorrectionMonitorConfig>(m, "CorrectionMonitorConfig")
       .def(py::init<>())
       .def_readwrite("window_s", &CorrectionMonitorConfig::window_s, "s")

@@ -114,8 +114,10 @@ def test_handoff_defaults_match_yaml() -> None:
         "max_smear_m",
         "max_map_odom_age_s",
     }
+    limits = dp.SeamLimits()
     for name, value in d.items():
         assert documented[name] == pytest.approx(value), name
+        assert getattr(limits, name) == pytest.approx(value), name
 
 
 def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:

@@ -13,6 +13,25 @@ double expectedSmear(double range_m, double yaw_rate_rps, double age_s) {
   return std::abs(range_m) * std::tan(angle);
 }
 
+SeamLimits SeamLimits::acceptValid(const SeamLimits& proposed, const SeamLimits& current,
+                                   std::vector<std::string>* refused) {
+  SeamLimits out = current;
+  const auto take = [refused](const char* name, double value, double* target) {
+    if (std::isfinite(value) && value > 0.0) {
+      *target = value;
+      return;
+    }
+    std::ostringstream why;
+    why << "parameter " << name << " = " << value << " must be > 0; keeping " << *target;
+    refused->push_back(why.str());
+  };
+  take("reference_range_m", proposed.reference_range_m, &out.reference_range_m);
+  take("max_transform_age_s", proposed.max_transform_age_s, &out.max_transform_age_s);
+  take("max_smear_m", proposed.max_smear_m, &out.max_smear_m);
+  take("max_map_odom_age_s", proposed.max_map_odom_age_s, &out.max_map_odom_age_s);
+  return out;
+}
+
 void SampleWindow::add(double value) {
   if (!std::isfinite(value)) return;
   samples_.push_back(value);

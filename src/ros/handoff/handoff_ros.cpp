@@ -70,25 +70,17 @@ void HandoffRos::loadParameters() {
 }
 
 void HandoffRos::reconfigure(HandoffConfig& cfg, std::uint32_t) {
-  SeamLimits limits;
+  SeamLimits proposed;
+  proposed.reference_range_m = cfg.reference_range_m;
+  proposed.max_transform_age_s = cfg.max_transform_age_s;
+  proposed.max_smear_m = cfg.max_smear_m;
+  proposed.max_map_odom_age_s = cfg.max_map_odom_age_s;
+  std::vector<std::string> refused;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    limits = limits_;
+    limits_ = SeamLimits::acceptValid(proposed, limits_, &refused);
   }
-  const auto set = [this](const char* name, double value, double* target) {
-    if (std::isfinite(value) && value > 0.0) {
-      *target = value;
-      return;
-    }
-    config_errors_.add(std::string("parameter ") + name + " = " + toText(value) +
-                       " must be > 0; keeping " + toText(*target));
-  };
-  set("reference_range_m", cfg.reference_range_m, &limits.reference_range_m);
-  set("max_transform_age_s", cfg.max_transform_age_s, &limits.max_transform_age_s);
-  set("max_smear_m", cfg.max_smear_m, &limits.max_smear_m);
-  set("max_map_odom_age_s", cfg.max_map_odom_age_s, &limits.max_map_odom_age_s);
-  std::lock_guard<std::mutex> lock(mutex_);
-  limits_ = limits;
+  for (const std::string& why : refused) config_errors_.add(why);
 }
 
 bool HandoffRos::transformPose(const geometry_msgs::PoseStamped& in,

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "downstream_perception/core/handoff/seam_health.h"
 
@@ -97,4 +99,23 @@ TEST(SeamHealth, BadSamplesAndConfigs) {
   c = CorrectionMonitorConfig();
   c.reset_drop_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(c.validate().find("reset_drop_m"), std::string::npos);
+}
+
+TEST(SeamHealth, SeamLimitsAcceptEachValidFieldAndKeepTheRest) {
+  SeamLimits current;
+  current.max_smear_m = 0.2;  // a value set earlier: what a refused key keeps
+  SeamLimits proposed;
+  proposed.reference_range_m = std::numeric_limits<double>::quiet_NaN();
+  proposed.max_transform_age_s = 0.3;
+  proposed.max_smear_m = -0.5;
+  proposed.max_map_odom_age_s = 4.0;
+  std::vector<std::string> refused;
+  const SeamLimits out = SeamLimits::acceptValid(proposed, current, &refused);
+  EXPECT_EQ(out.reference_range_m, 5.0);    // the default, kept
+  EXPECT_EQ(out.max_transform_age_s, 0.3);  // taken
+  EXPECT_EQ(out.max_smear_m, 0.2);          // the earlier value, kept
+  EXPECT_EQ(out.max_map_odom_age_s, 4.0);   // taken
+  ASSERT_EQ(refused.size(), 2u);
+  EXPECT_NE(refused[0].find("reference_range_m"), std::string::npos);
+  EXPECT_NE(refused[1].find("max_smear_m = -0.5 must be > 0; keeping 0.2"), std::string::npos);
 }

@@ -16,6 +16,21 @@ namespace downstream_perception {
 /// = 0.236 m).
 double expectedSmear(double range_m, double yaw_rate_rps, double age_s);
 
+/// The seam health's warning limits (the handoff's dynamic_reconfigure keys; cfg/Handoff.cfg's
+/// defaults equal these, a pytest compares them).
+struct SeamLimits {
+  double reference_range_m = 5.0;    ///< m: the range at which the smear is judged
+  double max_transform_age_s = 0.1;  ///< s: warn when an input's p95 transform age exceeds it
+  double max_smear_m = 0.05;         ///< m: warn when the expected smear exceeds it
+  double max_map_odom_age_s = 2.0;   ///< s: warn when map <- odom is older
+
+  /// `proposed`, field by field, where the field is finite and > 0; `current`'s value elsewhere,
+  /// with one line per refused field in `refused` ("<name> = <value> must be > 0; keeping <v>").
+  /// Field by field: one bad key must not undo the user's other, valid ones.
+  static SeamLimits acceptValid(const SeamLimits& proposed, const SeamLimits& current,
+                                std::vector<std::string>* refused);
+};
+
 /// Percentiles of the last `capacity` samples (transform ages).
 class SampleWindow {
  public:

@@ -32,14 +32,6 @@
 
 namespace downstream_perception {
 
-/// The seam health's warning limits (dynamic_reconfigure keys).
-struct SeamLimits {
-  double reference_range_m = 5.0;
-  double max_transform_age_s = 0.1;
-  double max_smear_m = 0.05;
-  double max_map_odom_age_s = 2.0;
-};
-
 class HandoffRos {
  public:
   HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh);
