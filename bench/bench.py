@@ -180,7 +180,7 @@ def main() -> None:
     binding = python_binding_overhead()
     sim = simulator_speed()
     tsdf = bench_tsdf.run()
-    latency = bench_latency.run()
+    latency = [bench_latency.run(), bench_latency.run(update_on_data=True)]
 
     lines = [
         "# downstream_perception benchmark",

@@ -105,16 +105,19 @@ void TrackInbox::onTracks(const TrackedObjectArrayConstPtr& msg) {
     }
     tracks.push_back(t);
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!stamp_.isZero() && msg->header.stamp < stamp_) {
-    rejected_.count("older than the tracks already held");
-    return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!stamp_.isZero() && msg->header.stamp < stamp_) {
+      rejected_.count("older than the tracks already held");
+      return;
+    }
+    tracks_ = std::move(tracks);
+    stamp_ = msg->header.stamp;
+    tracks_skipped_state_ += skipped_state;
+    ++arrays_received_;
+    transform_age_s_.add((ros::Time::now() - msg->header.stamp).toSec());
   }
-  tracks_ = std::move(tracks);
-  stamp_ = msg->header.stamp;
-  tracks_skipped_state_ += skipped_state;
-  ++arrays_received_;
-  transform_age_s_.add((ros::Time::now() - msg->header.stamp).toSec());
+  if (on_arrival_) on_arrival_();
 }
 
 FreshTracks TrackInbox::fresh(const ros::Time& now) {

@@ -19,6 +19,7 @@ TrackedObstacleLayer::~TrackedObstacleLayer() {
 }
 
 void TrackedObstacleLayer::onInitialize() {
+  inbox_.setArrivalHandler([this] { layered_costmap_->notifyDataArrived(); });  // update_on_data
   config_errors_.setPrefix("layer '" + name_ + "'");
   TrackInboxConfig inbox;
   ParamReader params(nh_, "layer '" + name_ + "'");

@@ -10,9 +10,11 @@
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/TrackedObjectArray.h"
@@ -48,6 +50,9 @@ class TrackInbox {
   void subscribe(ros::NodeHandle& nh, tf2_ros::Buffer& tf, const std::string& global_frame,
                  const std::string& owner);
   void unsubscribe();
+  /// Called (on the subscriber's thread, no lock held) after each array is taken: the owner's
+  /// cue for update_on_data. Set it before subscribe().
+  void setArrivalHandler(std::function<void()> handler) { on_arrival_ = std::move(handler); }
   /// Live part of the configuration (timeout, states); the topic and queue apply at subscribe().
   void setConfig(const TrackInboxConfig& config);
   TrackInboxConfig config() const;
@@ -83,6 +88,7 @@ class TrackInbox {
   std::size_t tracks_skipped_state_ = 0;
   RejectionCounter rejected_;
   RunningStats transform_age_s_;  ///< now - stamp when an array is transformed
+  std::function<void()> on_arrival_;
 };
 
 }  // namespace downstream_perception

@@ -40,21 +40,33 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   clear_service_ = pnh_.advertiseService("clear", &CostmapRos::clearService, this);
   update_timer_ = nh_.createTimer(ros::Duration(1.0 / config_.update_frequency),
                                   &CostmapRos::updateTimerCallback, this);
+  if (config_.update_on_data) {
+    data_trigger_.start(config_.update_on_data_max_rate_hz, [this] { onDataArrived(); });
+    layered_costmap_->setDataHandler([this] { data_trigger_.notify(); });
+  }
   // On the steady clock: a ROS-clock timer is what a jump of the ROS clock may hold up.
   clock_watch_ =
       nh_.createSteadyTimer(ros::WallDuration(kClockWatchPeriodS), &CostmapRos::watchClock, this);
   // Last: its first callback applies the YAML values again (a no-op) and from then on every
   // live change goes through reconfigure().
   reconfigure_.start(pnh_, this, &CostmapRos::reconfigure);
+  const std::string on_data =
+      config_.update_on_data
+          ? " and on new data (at most " + toText(config_.update_on_data_max_rate_hz) + " Hz)"
+          : "";
   ROS_INFO(
       "costmap: %d x %d cells at %.3f m in '%s', origin (%.2f, %.2f)%s, %zu layer(s), "
-      "update %.1f Hz, publish %.1f Hz",
+      "update %.1f Hz%s, publish %.1f Hz",
       config_.sizeXCells(), config_.sizeYCells(), config_.resolution, config_.global_frame.c_str(),
       config_.origin_x, config_.origin_y, config_.rolling_window ? " rolling with the robot" : "",
-      layered_costmap_->plugins().size(), config_.update_frequency, config_.publish_frequency);
+      layered_costmap_->plugins().size(), config_.update_frequency, on_data.c_str(),
+      config_.publish_frequency);
 }
 
 CostmapRos::~CostmapRos() {
+  // First: layers notify from their subscriber threads until they are destroyed.
+  layered_costmap_->setDataHandler(nullptr);
+  data_trigger_.stop();
   reconfigure_.stop();
   update_timer_.stop();
   clock_watch_.stop();
@@ -269,6 +281,20 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
     ++updates_skipped_busy_;
     return;
   }
+  if (!last_update_.isZero()) update_period_s_.add((event.current_real - last_update_).toSec());
+  last_update_ = event.current_real;
+  updateAndPublish(false);
+  diagnostics_.update();
+}
+
+void CostmapRos::onDataArrived() {
+  // The trigger's thread; waits for a timer update that is running (it may hold new data).
+  std::lock_guard<std::mutex> busy(update_mutex_);
+  ++data_updates_;
+  updateAndPublish(true);
+}
+
+void CostmapRos::updateAndPublish(bool on_data) {
   double x = 0.0;
   double y = 0.0;
   double yaw = 0.0;
@@ -285,21 +311,22 @@ void CostmapRos::updateTimerCallback(const ros::TimerEvent& event) {
   unpublished_.expand(layered_costmap_->updateMap(x, y, yaw, have_pose));
   const auto t1 = std::chrono::steady_clock::now();
   update_time_ms_.add(std::chrono::duration<double, std::milli>(t1 - t0).count());
-  if (!last_update_.isZero()) update_period_s_.add((event.current_real - last_update_).toSec());
-  last_update_ = event.current_real;
   ++updates_;
 
+  // publish_frequency 0 means "never publish" (costmap_2d), in either mode. New data is
+  // published at once when it changed the master (its rate is the trigger's limit); the timer
+  // publishes at publish_frequency, as costmap_2d does.
+  if (config_.publish_frequency <= 0.0) return;
   const ros::Time now = ros::Time::now();
-  if (config_.publish_frequency > 0.0 &&
-      (last_publish_.isZero() ||
-       (now - last_publish_).toSec() >= 1.0 / config_.publish_frequency)) {
-    std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
-    publisher_->publish(layered_costmap_->costmap(), now, unpublished_);
-    unpublished_ = CellBounds{};
-    last_publish_ = now;
-    footprint_publisher_.publish(footprint_msg_);
-  }
-  diagnostics_.update();
+  const bool due = on_data ? !unpublished_.empty() || last_publish_.isZero()
+                           : last_publish_.isZero() ||
+                                 (now - last_publish_).toSec() >= 1.0 / config_.publish_frequency;
+  if (!due) return;
+  std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
+  publisher_->publish(layered_costmap_->costmap(), now, unpublished_);
+  unpublished_ = CellBounds{};
+  last_publish_ = now;
+  footprint_publisher_.publish(footprint_msg_);
 }
 
 void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -342,6 +369,11 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("update time mean (ms)", update_time_ms_.mean());
   status.add("update time max (ms)", update_time_ms_.max);
   status.add("updates skipped (previous still running)", updates_skipped_busy_);
+  status.add("update on data", config_.update_on_data);
+  if (config_.update_on_data) {
+    status.add("updates on data", data_updates_);
+    status.add("data notifications (merged into those updates)", data_trigger_.notifications());
+  }
   status.add("robot pose failures", robot_pose_failures_);
   if (!last_pose_error_.empty()) status.add("last robot pose error", last_pose_error_);
   status.add("full grids published", publisher_ ? publisher_->fullGridsPublished() : 0);

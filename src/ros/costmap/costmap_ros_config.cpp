@@ -39,6 +39,8 @@ CostmapRosConfig readCostmapConfig(ParamReader& params, ConfigErrorLog* errors) 
   params.get("track_unknown_space", &c.track_unknown_space);
   params.get("rolling_window", &c.rolling_window);
   params.get("always_send_full_costmap", &c.always_send_full_costmap);
+  params.get("update_on_data", &c.update_on_data);
+  params.get("update_on_data_max_rate_hz", &c.update_on_data_max_rate_hz);
   validateCostmapConfig(&c, CostmapRosConfig(), errors);
   return c;
 }
@@ -56,14 +58,16 @@ const std::vector<std::string>& costmapConfigKeys() {
                                              "transform_tolerance",
                                              "track_unknown_space",
                                              "rolling_window",
-                                             "always_send_full_costmap"};
+                                             "always_send_full_costmap",
+                                             "update_on_data",
+                                             "update_on_data_max_rate_hz"};
   return keys;
 }
 
 void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback,
                            ConfigErrorLog* errors) {
   for (const char* key : {"update_frequency", "publish_frequency", "transform_tolerance",
-                          "width/height/resolution/origin"}) {
+                          "update_on_data_max_rate_hz", "width/height/resolution/origin"}) {
     errors->clearWithPrefix(key);
   }
   const auto reject = [errors](const std::string& name, const std::string& value,
@@ -85,6 +89,12 @@ void validateCostmapConfig(CostmapRosConfig* c, const CostmapRosConfig& fallback
     reject("transform_tolerance", toText(c->transform_tolerance),
            toText(fallback.transform_tolerance));
     c->transform_tolerance = fallback.transform_tolerance;
+  }
+  if (!std::isfinite(c->update_on_data_max_rate_hz) || c->update_on_data_max_rate_hz <= 0.0 ||
+      c->update_on_data_max_rate_hz > 1000.0) {
+    reject("update_on_data_max_rate_hz", toText(c->update_on_data_max_rate_hz),
+           toText(fallback.update_on_data_max_rate_hz));
+    c->update_on_data_max_rate_hz = fallback.update_on_data_max_rate_hz;
   }
   const std::string why =
       (std::isfinite(c->width) && std::isfinite(c->height) && c->resolution > 0.0)

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace downstream_perception {
 
@@ -95,6 +96,16 @@ void LayeredCostmap::setFootprint(const Footprint& footprint) {
   inscribed_radius_ = downstream_perception::inscribedRadius(footprint);
   circumscribed_radius_ = downstream_perception::circumscribedRadius(footprint);
   for (const auto& plugin : plugins_) plugin->onFootprintChanged();
+}
+
+void LayeredCostmap::notifyDataArrived() {
+  std::lock_guard<std::mutex> lock(data_handler_mutex_);
+  if (data_handler_) data_handler_();
+}
+
+void LayeredCostmap::setDataHandler(std::function<void()> handler) {
+  std::lock_guard<std::mutex> lock(data_handler_mutex_);
+  data_handler_ = std::move(handler);
 }
 
 }  // namespace downstream_perception

@@ -22,6 +22,7 @@
 #include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/costmap_publisher.h"
 #include "downstream_perception/ros/costmap/costmap_ros_config.h"
+#include "downstream_perception/ros/costmap/data_update_trigger.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
 
 namespace downstream_perception {
@@ -39,6 +40,10 @@ class CostmapRos {
   void auditKeys(ParamReader& params);
   void reconfigure(CostmapConfig& cfg, std::uint32_t level);
   void updateTimerCallback(const ros::TimerEvent& event);
+  /// update_on_data: a layer integrated new data (on the trigger's thread).
+  void onDataArrived();
+  /// One update of the master, then a publish if due; update_mutex_ held by the caller.
+  void updateAndPublish(bool on_data);
   /// Resets what depends on time when the ROS clock went back.
   void watchClock(const ros::SteadyTimerEvent&);
   bool robotPose(double* x, double* y, double* yaw);
@@ -73,6 +78,8 @@ class CostmapRos {
   ros::SteadyTimer clock_watch_;
   std::mutex update_mutex_;  ///< one update at a time even on a multi-threaded queue
   std::size_t updates_skipped_busy_ = 0;
+  DataUpdateTrigger data_trigger_;  ///< update_on_data: updates right after new data
+  std::size_t data_updates_ = 0;
   CellBounds unpublished_;  ///< cells redrawn since the last publish
   ros::Time last_publish_;
   ClockJumpDetector clock_jump_;

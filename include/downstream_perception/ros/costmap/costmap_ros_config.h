@@ -25,6 +25,11 @@ struct CostmapRosConfig {
   bool track_unknown_space = false;       ///< costmap_2d's default: unknown cells are free
   bool rolling_window = false;            ///< keep the map centred on the robot (whole-cell shifts)
   bool always_send_full_costmap = false;  ///< no ~costmap_updates: the whole grid every time
+  // Our keys (costmap_2d has no such mode): update and publish as soon as a layer has integrated
+  // new data, besides the update_frequency timer (which keeps running: rolling, decay,
+  // timeouts). Off by default, so costmap_2d's timer semantics hold unless asked for.
+  bool update_on_data = false;
+  double update_on_data_max_rate_hz = 50.0;  ///< Hz: data-driven updates at most this often
 
   int sizeXCells() const;
   int sizeYCells() const;

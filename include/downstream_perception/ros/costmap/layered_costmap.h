@@ -59,6 +59,14 @@ class LayeredCostmap {
   /// Tells every layer that the ROS clock went back.
   void onClockJump();
 
+  /// Called by a layer once it has integrated new data (a scan, a cloud, a track array, a
+  /// slice): the host's update_on_data mode updates and publishes right after. Cheap; any
+  /// thread. Without a handler (timer mode, the costmap_2d adapter's shadow) it does nothing.
+  void notifyDataArrived();
+  /// The host's reaction to notifyDataArrived() (empty: none). Clear it before the host's
+  /// trigger goes away: layers may notify from their subscriber threads until they are destroyed.
+  void setDataHandler(std::function<void()> handler);
+
   Costmap& costmap() { return master_; }
   const Costmap& costmap() const { return master_; }
   /// Held by updateMap(); take it to read the master consistently from another thread.
@@ -88,6 +96,8 @@ class LayeredCostmap {
   std::atomic<bool> full_redraw_{false};
   std::atomic<bool> size_locked_{false};
   std::function<void(const GridGeometry&)> size_lock_handler_;
+  std::mutex data_handler_mutex_;
+  std::function<void()> data_handler_;
 };
 
 }  // namespace downstream_perception
