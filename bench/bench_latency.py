@@ -56,6 +56,21 @@ class Probe:
         rospy.Subscriber(
             "/costmap/costmap_updates", OccupancyGridUpdate, self.on_update, queue_size=50
         )
+        from diagnostic_msgs.msg import DiagnosticArray
+
+        # The costmap's own figure: data stamp -> costmap message handed to the publisher (the
+        # last 200 publishes), free of this process's receive path.
+        self.host: dict[str, float] = {}
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=20)
+
+    def on_diagnostics(self, msg: Any) -> None:
+        for status in msg.status:
+            if not status.name.endswith("costmap: costmap"):
+                continue
+            for kv in status.values:
+                if kv.key.startswith("data stamp to publish"):
+                    with self.lock:
+                        self.host[kv.key.split()[-2]] = float(kv.value)
 
     def watch(self, key: Any, stamps: list[Any], x: float, y: float, half: int = 1) -> None:
         r, c = cell(x, y)
@@ -230,6 +245,7 @@ def measure(duration_s: float) -> dict[str, Any]:
         "object_first": stats(first),
         "object_confirm": stats(confirm),
         "object_missed": float(probe.missed["object"]),
+        "host_data_to_publish_ms": dict(probe.host),
     }
 
 
@@ -247,6 +263,13 @@ def markdown(runs: list[dict[str, Any]]) -> list[str]:
             row(mode, "first detection -> tracked cells (incl. min_hits = 3)", r["object_first"]),
             row(mode, "confirming detection -> tracked cells", r["object_confirm"]),
         ]
+        host = r.get("host_data_to_publish_ms", {})
+        if host:
+            rows.append(
+                f"| {mode} | costmap's own: oldest data stamp -> handed to the publisher "
+                f"(last 200) | | {host.get('p50', float('nan')):.1f} | "
+                f"{host.get('p99', float('nan')):.1f} | {host.get('max', float('nan')):.1f} |"
+            )
         missed.append(
             f"{mode}: {int(r['scan_missed'])} scans, {int(r['object_missed'])} objects never seen"
         )

@@ -387,7 +387,7 @@ void LogOddsObstacleLayer::integrate(ObservationSource& source, const Observatio
   const auto t1 = std::chrono::steady_clock::now();
   const double age = (ros::Time::now() - observation.stamp).toSec();
   source.recordIntegration(stats, std::chrono::duration<double, std::milli>(t1 - t0).count(), age);
-  if (!stats.changed.empty()) layered_costmap_->notifyDataArrived();  // update_on_data
+  if (!stats.changed.empty()) layered_costmap_->notifyDataArrived(observation.stamp);
 }
 
 void LogOddsObstacleLayer::clearFootprint(double robot_x, double robot_y, double robot_yaw) {

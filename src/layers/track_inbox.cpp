@@ -117,7 +117,7 @@ void TrackInbox::onTracks(const TrackedObjectArrayConstPtr& msg) {
     ++arrays_received_;
     transform_age_s_.add((ros::Time::now() - msg->header.stamp).toSec());
   }
-  if (on_arrival_) on_arrival_();
+  if (on_arrival_) on_arrival_(msg->header.stamp);
 }
 
 FreshTracks TrackInbox::fresh(const ros::Time& now) {

@@ -19,7 +19,8 @@ TrackedObstacleLayer::~TrackedObstacleLayer() {
 }
 
 void TrackedObstacleLayer::onInitialize() {
-  inbox_.setArrivalHandler([this] { layered_costmap_->notifyDataArrived(); });  // update_on_data
+  inbox_.setArrivalHandler(
+      [this](const ros::Time& stamp) { layered_costmap_->notifyDataArrived(stamp); });
   config_errors_.setPrefix("layer '" + name_ + "'");
   TrackInboxConfig inbox;
   ParamReader params(nh_, "layer '" + name_ + "'");

@@ -56,7 +56,7 @@ void TsdfLayer::onSlice(const nav_msgs::OccupancyGridConstPtr& msg) {
   slice_ = msg;
   slice_changed_ = true;
   ++slices_received_;
-  layered_costmap_->notifyDataArrived();  // update_on_data
+  layered_costmap_->notifyDataArrived(msg->header.stamp);
 }
 
 void TsdfLayer::updateBounds(double, double, double, double* min_x, double* min_y, double* max_x,

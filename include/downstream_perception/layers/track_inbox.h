@@ -50,9 +50,11 @@ class TrackInbox {
   void subscribe(ros::NodeHandle& nh, tf2_ros::Buffer& tf, const std::string& global_frame,
                  const std::string& owner);
   void unsubscribe();
-  /// Called (on the subscriber's thread, no lock held) after each array is taken: the owner's
-  /// cue for update_on_data. Set it before subscribe().
-  void setArrivalHandler(std::function<void()> handler) { on_arrival_ = std::move(handler); }
+  /// Called with the array's stamp (on the subscriber's thread, no lock held) after each array
+  /// is taken: the owner's cue for the host (update_on_data, latency). Set it before subscribe().
+  void setArrivalHandler(std::function<void(const ros::Time&)> handler) {
+    on_arrival_ = std::move(handler);
+  }
   /// Live part of the configuration (timeout, states); the topic and queue apply at subscribe().
   void setConfig(const TrackInboxConfig& config);
   TrackInboxConfig config() const;
@@ -88,7 +90,7 @@ class TrackInbox {
   std::size_t tracks_skipped_state_ = 0;
   RejectionCounter rejected_;
   RunningStats transform_age_s_;  ///< now - stamp when an array is transformed
-  std::function<void()> on_arrival_;
+  std::function<void(const ros::Time&)> on_arrival_;
 };
 
 }  // namespace downstream_perception

@@ -32,23 +32,6 @@ SeamLimits SeamLimits::acceptValid(const SeamLimits& proposed, const SeamLimits&
   return out;
 }
 
-void SampleWindow::add(double value) {
-  if (!std::isfinite(value)) return;
-  samples_.push_back(value);
-  ++total_;
-  while (samples_.size() > capacity_) samples_.pop_front();
-}
-
-double SampleWindow::percentile(double q) const {
-  if (samples_.empty()) return 0.0;
-  std::vector<double> sorted(samples_.begin(), samples_.end());
-  const std::size_t rank = static_cast<std::size_t>(
-      std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(sorted.size())));
-  const std::size_t k = rank == 0 ? 0 : rank - 1;
-  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  return sorted[k];
-}
-
 std::string CorrectionMonitorConfig::validate() const {
   std::ostringstream why;
   const auto bad = [](double v) { return !(std::isfinite(v) && v > 0.0); };

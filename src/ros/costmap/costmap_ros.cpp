@@ -42,8 +42,18 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
                                   &CostmapRos::updateTimerCallback, this);
   if (config_.update_on_data) {
     data_trigger_.start(config_.update_on_data_max_rate_hz, [this] { onDataArrived(); });
-    layered_costmap_->setDataHandler([this] { data_trigger_.notify(); });
   }
+  // In both modes: how long integrated data waits to be published (diagnostics); the trigger
+  // is a no-op unless started.
+  layered_costmap_->setDataHandler([this](const ros::Time& stamp) {
+    {
+      std::lock_guard<std::mutex> lock(data_stamp_mutex_);
+      if (oldest_unpublished_stamp_.isZero() || stamp < oldest_unpublished_stamp_) {
+        oldest_unpublished_stamp_ = stamp;
+      }
+    }
+    data_trigger_.notify();
+  });
   // On the steady clock: a ROS-clock timer is what a jump of the ROS clock may hold up.
   clock_watch_ =
       nh_.createSteadyTimer(ros::WallDuration(kClockWatchPeriodS), &CostmapRos::watchClock, this);
@@ -271,6 +281,8 @@ void CostmapRos::watchClock(const ros::SteadyTimerEvent&) {
     restartTf(*tf_buffer_, tf_listener_, nh_);
     layered_costmap_->onClockJump();
     last_publish_ = ros::Time();  // else nothing is published until the clock passes it again
+    std::lock_guard<std::mutex> stamps(data_stamp_mutex_);
+    oldest_unpublished_stamp_ = ros::Time();  // of the old timeline
   }
   diagnostics_.force_update();  // the updater, too, waits for its next (old-timeline) time
 }
@@ -327,6 +339,14 @@ void CostmapRos::updateAndPublish(bool on_data) {
   unpublished_ = CellBounds{};
   last_publish_ = now;
   footprint_publisher_.publish(footprint_msg_);
+  std::lock_guard<std::mutex> stamps(data_stamp_mutex_);
+  if (!oldest_unpublished_stamp_.isZero()) {
+    // The oldest data in this message: stamp -> handed to the publisher, in ms.
+    const double ms = 1e3 * (ros::Time::now() - oldest_unpublished_stamp_).toSec();
+    data_to_publish_ms_.add(ms);
+    data_to_publish_max_ms_ = std::max(data_to_publish_max_ms_, ms);
+    oldest_unpublished_stamp_ = ros::Time();
+  }
 }
 
 void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -370,6 +390,13 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("update time max (ms)", update_time_ms_.max);
   status.add("updates skipped (previous still running)", updates_skipped_busy_);
   status.add("update on data", config_.update_on_data);
+  if (data_to_publish_ms_.total() > 0) {
+    // Measured from each message's stamp (sensor time) to the costmap message handed to the
+    // publisher, for the oldest data in each published message; last 200 publishes.
+    status.add("data stamp to publish p50 (ms)", data_to_publish_ms_.percentile(0.5));
+    status.add("data stamp to publish p99 (ms)", data_to_publish_ms_.percentile(0.99));
+    status.add("data stamp to publish max (ms)", data_to_publish_max_ms_);
+  }
   if (config_.update_on_data) {
     status.add("updates on data", data_updates_);
     status.add("data notifications (merged into those updates)", data_trigger_.notifications());

@@ -1,5 +1,6 @@
 #include "downstream_perception/ros/costmap/data_update_trigger.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace downstream_perception {
@@ -8,8 +9,7 @@ void DataUpdateTrigger::start(double max_rate_hz, std::function<void()> update) 
   stop();
   std::lock_guard<std::mutex> lock(mutex_);
   update_ = std::move(update);
-  min_period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(1.0 / max_rate_hz));
+  rate_hz_ = max_rate_hz;
   running_ = true;
   pending_ = false;
   thread_ = std::thread(&DataUpdateTrigger::run, this);
@@ -46,16 +46,27 @@ std::size_t DataUpdateTrigger::updates() const {
 }
 
 void DataUpdateTrigger::run() {
-  // The first update may run at once.
-  auto next_allowed = std::chrono::steady_clock::now();
+  using Clock = std::chrono::steady_clock;
+  double tokens = kBurst;
+  auto refilled_at = Clock::now();
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     wake_.wait(lock, [this] { return pending_ || !running_; });
     if (!running_) return;
-    // Rate limit: notifications arriving meanwhile join this update.
-    if (wake_.wait_until(lock, next_allowed, [this] { return !running_; })) return;
+    const auto now = Clock::now();
+    tokens = std::min(kBurst,
+                      tokens + rate_hz_ * std::chrono::duration<double>(now - refilled_at).count());
+    refilled_at = now;
+    if (tokens < 1.0) {
+      // Rate limit: notifications arriving meanwhile join this update.
+      const auto due = now + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>((1.0 - tokens) / rate_hz_));
+      if (wake_.wait_until(lock, due, [this] { return !running_; })) return;
+      tokens = 1.0;
+      refilled_at = Clock::now();
+    }
+    tokens -= 1.0;
     pending_ = false;
-    next_allowed = std::chrono::steady_clock::now() + min_period_;
     ++updates_;
     lock.unlock();
     update_();  // without the lock: notify() must never wait for an update

@@ -98,12 +98,12 @@ void LayeredCostmap::setFootprint(const Footprint& footprint) {
   for (const auto& plugin : plugins_) plugin->onFootprintChanged();
 }
 
-void LayeredCostmap::notifyDataArrived() {
+void LayeredCostmap::notifyDataArrived(const ros::Time& stamp) {
   std::lock_guard<std::mutex> lock(data_handler_mutex_);
-  if (data_handler_) data_handler_();
+  if (data_handler_) data_handler_(stamp);
 }
 
-void LayeredCostmap::setDataHandler(std::function<void()> handler) {
+void LayeredCostmap::setDataHandler(std::function<void(const ros::Time&)> handler) {
   std::lock_guard<std::mutex> lock(data_handler_mutex_);
   data_handler_ = std::move(handler);
 }

@@ -51,18 +51,20 @@ TEST(DataUpdateTrigger, OneNotificationRunsExactlyOneUpdate) {
   EXPECT_EQ(trigger.updates(), 1u);
 }
 
-TEST(DataUpdateTrigger, NotificationsWithinThePeriodJoinOneLaterUpdate) {
+TEST(DataUpdateTrigger, ABurstRunsAtOnceThenNotificationsJoinOneLaterUpdate) {
   UpdateCounter counter;
   DataUpdateTrigger trigger;
-  trigger.start(0.1, [&] { counter(); });  // at most one update per 10 s
-  trigger.notify();
-  ASSERT_TRUE(counter.waitFor(1));
+  trigger.start(0.1, [&] { counter(); });  // one token per 10 s, kBurst = 3 at start
+  for (int k = 1; k <= 3; ++k) {
+    trigger.notify();
+    ASSERT_TRUE(counter.waitFor(k));  // each of the first three runs at once
+  }
   for (int k = 0; k < 5; ++k) trigger.notify();
   std::this_thread::sleep_for(milliseconds(300));
-  EXPECT_EQ(counter.count(), 1);  // the five wait, merged, for the period to end
-  EXPECT_EQ(trigger.notifications(), 6u);
+  EXPECT_EQ(counter.count(), 3);  // the bucket is empty: the five wait, merged, for a token
+  EXPECT_EQ(trigger.notifications(), 8u);
   trigger.stop();  // returns at once: the pending update is dropped, not awaited
-  EXPECT_EQ(counter.count(), 1);
+  EXPECT_EQ(counter.count(), 3);
 }
 
 TEST(DataUpdateTrigger, ANotificationDuringAnUpdateSchedulesAnother) {

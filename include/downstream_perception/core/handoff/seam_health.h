@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "downstream_perception/core/running_stats.h"
+
 namespace downstream_perception {
 
 /// Sideways throw (m) of an obstacle at range_m placed with a transform age_s old while the robot
@@ -29,23 +31,6 @@ struct SeamLimits {
   /// Field by field: one bad key must not undo the user's other, valid ones.
   static SeamLimits acceptValid(const SeamLimits& proposed, const SeamLimits& current,
                                 std::vector<std::string>* refused);
-};
-
-/// Percentiles of the last `capacity` samples (transform ages).
-class SampleWindow {
- public:
-  explicit SampleWindow(std::size_t capacity = 200) : capacity_(capacity) {}
-  void add(double value);
-  /// The q-quantile (q in [0, 1], nearest rank) of the samples held; 0 if none.
-  double percentile(double q) const;
-  std::size_t size() const { return samples_.size(); }
-  std::size_t total() const { return total_; }
-  void clear() { samples_.clear(); }
-
- private:
-  std::size_t capacity_;
-  std::size_t total_ = 0;
-  std::deque<double> samples_;
 };
 
 struct CorrectionMonitorConfig {

@@ -80,6 +80,10 @@ class CostmapRos {
   std::size_t updates_skipped_busy_ = 0;
   DataUpdateTrigger data_trigger_;  ///< update_on_data: updates right after new data
   std::size_t data_updates_ = 0;
+  std::mutex data_stamp_mutex_;
+  ros::Time oldest_unpublished_stamp_;  ///< of data integrated since the last publish (0: none)
+  SampleWindow data_to_publish_ms_;     ///< stamp -> publish of the oldest data in a message
+  double data_to_publish_max_ms_ = 0.0;
   CellBounds unpublished_;  ///< cells redrawn since the last publish
   ros::Time last_publish_;
   ClockJumpDetector clock_jump_;

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <ros/time.h>
+
 #include "downstream_perception/core/costmap/footprint.h"
 #include "downstream_perception/core/grid/costmap.h"
 #include "downstream_perception/ros/costmap/layer.h"
@@ -59,13 +61,14 @@ class LayeredCostmap {
   /// Tells every layer that the ROS clock went back.
   void onClockJump();
 
-  /// Called by a layer once it has integrated new data (a scan, a cloud, a track array, a
-  /// slice): the host's update_on_data mode updates and publishes right after. Cheap; any
-  /// thread. Without a handler (timer mode, the costmap_2d adapter's shadow) it does nothing.
-  void notifyDataArrived();
-  /// The host's reaction to notifyDataArrived() (empty: none). Clear it before the host's
-  /// trigger goes away: layers may notify from their subscriber threads until they are destroyed.
-  void setDataHandler(std::function<void()> handler);
+  /// Called by a layer once it has integrated new data stamped `stamp` (a scan, a cloud, a track
+  /// array, a slice) that changes its output: the host measures how long data waits to be
+  /// published, and its update_on_data mode updates and publishes right after. Cheap; any
+  /// thread. Without a handler (the costmap_2d adapter's shadow) it does nothing.
+  void notifyDataArrived(const ros::Time& stamp);
+  /// The host's reaction to notifyDataArrived() (empty: none). Clear it before the host goes
+  /// away: layers may notify from their subscriber threads until they are destroyed.
+  void setDataHandler(std::function<void(const ros::Time&)> handler);
 
   Costmap& costmap() { return master_; }
   const Costmap& costmap() const { return master_; }
@@ -97,7 +100,7 @@ class LayeredCostmap {
   std::atomic<bool> size_locked_{false};
   std::function<void(const GridGeometry&)> size_lock_handler_;
   std::mutex data_handler_mutex_;
-  std::function<void()> data_handler_;
+  std::function<void(const ros::Time&)> data_handler_;
 };
 
 }  // namespace downstream_perception
