@@ -125,6 +125,5 @@ def score(
 
 
 def image_defaults() -> dp.TrackerConfig:
-    config = dp.TrackerConfig()
-    config.mode = dp.TrackerConfig.Mode.IMAGE
-    return config
+    """Image mode's documented defaults (TrackerConfig::defaultsFor)."""
+    return dp.TrackerConfig.defaults_for(dp.TrackerConfig.Mode.IMAGE)

@@ -40,6 +40,37 @@ std::string TrackerConfig::validate() const {
   return why.str();
 }
 
+TrackerConfig TrackerConfig::defaultsFor(Mode mode) {
+  TrackerConfig config;
+  config.mode = mode;
+  if (mode == Mode::kImage) config.min_hits = 2;
+  return config;
+}
+
+std::vector<std::pair<std::string, double>> TrackerConfig::modeSpecificDefaults(Mode mode) {
+  const TrackerConfig metric = defaultsFor(Mode::kMetric);
+  const TrackerConfig own = defaultsFor(mode);
+  // Every numeric field a YAML can set (the dynamic_reconfigure names).
+  const std::vector<std::pair<std::string, std::pair<double, double>>> fields = {
+      {"gate_confidence", {metric.gate_confidence, own.gate_confidence}},
+      {"duplicate_confidence", {metric.duplicate_confidence, own.duplicate_confidence}},
+      {"reid_confidence", {metric.reid_confidence, own.reid_confidence}},
+      {"min_iou", {metric.min_iou, own.min_iou}},
+      {"accel_psd", {metric.accel_psd, own.accel_psd}},
+      {"measurement_std", {metric.measurement_std, own.measurement_std}},
+      {"initial_velocity_std", {metric.initial_velocity_std, own.initial_velocity_std}},
+      {"min_hits", {metric.min_hits, own.min_hits}},
+      {"max_age_s", {metric.max_age_s, own.max_age_s}},
+      {"high_score", {metric.high_score, own.high_score}},
+      {"low_score", {metric.low_score, own.low_score}},
+  };
+  std::vector<std::pair<std::string, double>> differing;
+  for (const auto& [name, values] : fields) {
+    if (values.first != values.second) differing.emplace_back(name, values.second);
+  }
+  return differing;
+}
+
 void TrackerStats::accumulate(const TrackerStats& o) {
   detections += o.detections;
   detections_ignored_low_score += o.detections_ignored_low_score;
