@@ -199,7 +199,13 @@ void bindTracking(py::module& m) {
       .def_readwrite("low_score", &TrackerConfig::low_score)
       .def_readwrite("second_pass", &TrackerConfig::second_pass)
       .def_readwrite("class_aware", &TrackerConfig::class_aware)
-      .def("validate", &TrackerConfig::validate);
+      .def("validate", &TrackerConfig::validate)
+      .def_static("defaults_for", &TrackerConfig::defaultsFor, py::arg("mode"),
+                  "The mode's documented defaults. TrackerConfig() is the metric ones; setting "
+                  "mode on it keeps every other field as it is.")
+      .def_static("mode_specific_defaults", &TrackerConfig::modeSpecificDefaults, py::arg("mode"),
+                  "[(name, value)] of the fields whose default in this mode differs from the "
+                  "metric one.");
   py::class_<TrackerStats>(m, "TrackerStats")
       .def_readonly("detections", &TrackerStats::detections)
       .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score)

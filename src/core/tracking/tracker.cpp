@@ -40,6 +40,37 @@ std::string TrackerConfig::validate() const {
   return why.str();
 }
 
+TrackerConfig TrackerConfig::defaultsFor(Mode mode) {
+  TrackerConfig config;
+  config.mode = mode;
+  if (mode == Mode::kImage) config.min_hits = 2;
+  return config;
+}
+
+std::vector<std::pair<std::string, double>> TrackerConfig::modeSpecificDefaults(Mode mode) {
+  const TrackerConfig metric = defaultsFor(Mode::kMetric);
+  const TrackerConfig own = defaultsFor(mode);
+  // Every numeric field a YAML can set (the dynamic_reconfigure names).
+  const std::vector<std::pair<std::string, std::pair<double, double>>> fields = {
+      {"gate_confidence", {metric.gate_confidence, own.gate_confidence}},
+      {"duplicate_confidence", {metric.duplicate_confidence, own.duplicate_confidence}},
+      {"reid_confidence", {metric.reid_confidence, own.reid_confidence}},
+      {"min_iou", {metric.min_iou, own.min_iou}},
+      {"accel_psd", {metric.accel_psd, own.accel_psd}},
+      {"measurement_std", {metric.measurement_std, own.measurement_std}},
+      {"initial_velocity_std", {metric.initial_velocity_std, own.initial_velocity_std}},
+      {"min_hits", {metric.min_hits, own.min_hits}},
+      {"max_age_s", {metric.max_age_s, own.max_age_s}},
+      {"high_score", {metric.high_score, own.high_score}},
+      {"low_score", {metric.low_score, own.low_score}},
+  };
+  std::vector<std::pair<std::string, double>> differing;
+  for (const auto& [name, values] : fields) {
+    if (values.first != values.second) differing.emplace_back(name, values.second);
+  }
+  return differing;
+}
+
 void TrackerStats::accumulate(const TrackerStats& o) {
   detections += o.detections;
   detections_ignored_low_score += o.detections_ignored_low_score;
@@ -259,9 +290,29 @@ struct Core : Tracker::Impl {
         for (; it != by_x.end() && it->first <= x + reach; ++it) consider(it->second, j);
       }
     } else {
+      // Sweep and prune along x: two boxes overlap only if their centres are closer in x than
+      // half their summed widths, so with tracks sorted by centre x each detection looks at
+      // the tracks within (widest track + its width) / 2. Entries are then put back in
+      // row-major order, so the solver sees exactly what the all-pairs loop gave it.
+      std::vector<std::pair<double, std::size_t>> by_x;
+      by_x.reserve(cands.size());
+      double widest = 0.0;
       for (std::size_t i = 0; i < cands.size(); ++i) {
-        for (std::size_t j = 0; j < dets.size(); ++j) consider(i, j);
+        const Vec p = states[cands[i]].filter.position();
+        by_x.emplace_back(p(0), i);
+        widest = std::max(widest, std::abs(p(2)));
       }
+      std::sort(by_x.begin(), by_x.end());
+      for (std::size_t j = 0; j < dets.size(); ++j) {
+        const double x = z[dets[j]](0);
+        const double reach = 0.5 * (widest + z[dets[j]](2));
+        auto it =
+            std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(x - reach, std::size_t{0}));
+        for (; it != by_x.end() && it->first <= x + reach; ++it) consider(it->second, j);
+      }
+      std::sort(entries.begin(), entries.end(), [](const CostEntry& a, const CostEntry& b) {
+        return a.row != b.row ? a.row < b.row : a.col < b.col;
+      });
     }
     const std::vector<int> match =
         solveAssignment(static_cast<int>(cands.size()), static_cast<int>(dets.size()), entries);

@@ -38,8 +38,10 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.setHardwareID("tracker " + tracking_frame_);
   diagnostics_.add("tracker", this, &TrackerRos::diagnose);
 
-  // The server reads the YAML values (or the .cfg defaults, equal to TrackerConfig's) and calls
-  // reconfigure() at once: one code path for start-up and live changes.
+  // The server reads the YAML values (or the .cfg defaults, equal to TrackerConfig's metric
+  // ones, where the mode has no default of its own) and calls reconfigure() at once: one code
+  // path for start-up and live changes.
+  applyModeDefaults(config.mode);
   reconfigure_.start(pnh_, this, &TrackerRos::reconfigure);
 
   if (image_mode_) {
@@ -62,6 +64,28 @@ TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   ROS_INFO("tracker: %s mode, tracking in '%s', detections on %s", mode.c_str(),
            image_mode_ ? "the detections' frame" : tracking_frame_.c_str(),
            ros::names::resolve(nh_.getNamespace(), "detections").c_str());
+}
+
+// Issue 21: image mode used to run on the metric defaults read in its own units. A key set in
+// the YAML keeps its value and meaning; only unset keys take the mode's default, written to the
+// parameter server (so `rosparam get` shows what runs) and logged once, here.
+void TrackerRos::applyModeDefaults(TrackerConfig::Mode mode) {
+  std::ostringstream applied;
+  for (const auto& [name, value] : TrackerConfig::modeSpecificDefaults(mode)) {
+    if (pnh_.hasParam(name)) continue;
+    if (name == "min_hits") {  // the one integer parameter: the server reads it as an int
+      pnh_.setParam(name, static_cast<int>(value));
+    } else {
+      pnh_.setParam(name, value);
+    }
+    applied << (applied.tellp() > 0 ? ", " : "") << name << " " << value;
+  }
+  if (applied.tellp() > 0) {
+    ROS_WARN(
+        "tracker: %s mode defaults for the parameters not set: %s (before issue 21 image "
+        "mode used the metric defaults; set a key to keep the old value)",
+        mode == TrackerConfig::Mode::kImage ? "image" : "metric", applied.str().c_str());
+  }
 }
 
 void TrackerRos::watchClock(const ros::SteadyTimerEvent&) {

@@ -118,6 +118,26 @@ TEST(Tracker, ImageModeAssociatesByIou) {
   EXPECT_NEAR(tracker.tracks()[0].size_y, 100.0, 1.0);
 }
 
+TEST(Tracker, ImageModeFindsADetectionAtTheFarEdgeOfAWideBox) {
+  // Image association prunes pairs by centre distance in x (at most half the summed widths):
+  // a narrow box at the right edge of a 400 px wide track overlaps it although the centres are
+  // 190 px apart, and must still be associated; a narrow track in between changes nothing.
+  TrackerConfig c = TrackerConfig::defaultsFor(TrackerConfig::Mode::kImage);
+  c.min_iou = 0.01;
+  c.min_hits = 1;
+  Tracker tracker(c);
+  Detection wide, narrow, edge;
+  wide.box = {0.0, 0.0, 400.0, 100.0};
+  narrow.box = {150.0, 200.0, 170.0, 300.0};
+  edge.box = {380.0, 0.0, 400.0, 100.0};  // IoU with the wide box: 2000 / 40000 = 0.05
+  tracker.step(0.0, {wide, narrow});
+  ASSERT_EQ(tracker.tracks().size(), 2u);
+  const std::uint64_t wide_id = tracker.lastAssignment()[0];
+  const TrackerStats s = tracker.step(0.04, {edge});
+  EXPECT_EQ(s.births, 0u);
+  EXPECT_EQ(tracker.lastAssignment()[0], wide_id);
+}
+
 TEST(Tracker, ACoastingImageBoxNeverTurnsInsideOut) {
   // Issue 21's example: a box shrinking 4 px a frame at 25 fps, then nothing: its width kept
   // shrinking at constant velocity while it coasted, to -0.44 px at frame 26.

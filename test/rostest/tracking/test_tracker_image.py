@@ -4,7 +4,8 @@
 Box 0 (60 x 120 px) moves right at 50 px/s, box 1 (50 x 110 px) stands still, both with 1 px
 noise at 10 Hz in frame `camera`. Box 0 is hidden for frames 30-32. Tracks must stay in the
 camera frame with box sizes and pixel velocities, one id per box across the gap; a metric
-(POSITION) detection sent to an image-mode tracker is counted invalid, not guessed at.
+(POSITION) detection sent to an image-mode tracker is counted invalid, not guessed at; the
+parameters the YAML leaves unset take the image-mode defaults.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
 
+import downstream_perception as dp
 from downstream_perception.msg import DetectedObject, DetectedObjectArray, TrackedObjectArray
 from downstream_perception.ros.util import wait_until
 
@@ -121,6 +123,17 @@ class TrackerImageTest(unittest.TestCase):
             ),
             f"diagnostics: {self.status}",
         )
+
+    def test_3_unset_parameters_take_the_image_defaults(self) -> None:
+        # Issue 21 defect 6: tracker_image.yaml sets only the mode (and min_iou); every key it
+        # leaves unset whose image default differs from the metric one is written to the
+        # parameter server with the image value; a key it sets keeps its value.
+        image = dp.TrackerConfig.Mode.IMAGE
+        differing = dict(dp.TrackerConfig.mode_specific_defaults(image))
+        self.assertIn("min_hits", differing)
+        for name, value in differing.items():
+            self.assertAlmostEqual(rospy.get_param(f"/tracker/{name}"), value, msg=name)
+        self.assertEqual(rospy.get_param("/tracker/min_iou"), 0.25)
 
 
 if __name__ == "__main__":

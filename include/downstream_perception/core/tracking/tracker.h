@@ -23,6 +23,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/tracking/box.h"
@@ -62,6 +63,8 @@ struct TrackerConfig {
   static constexpr double kMaxStampS = 1e10;
 
   enum class Mode { kMetric, kImage };
+  /// The member initialisers below are the metric defaults (a default-constructed config is
+  /// metric, as it always was). Image mode has its own defaults: start from defaultsFor(kImage).
   Mode mode = Mode::kMetric;
   double gate_confidence = 0.999;  ///< chi-square gate (metric): 2 dof, 0.99 -> 9.21, 0.999 -> 13.8
   /// Metric mode: a coasting track this close (chi-square gate, 2 dof, sum of both position
@@ -74,22 +77,33 @@ struct TrackerConfig {
   /// 0.99999 -> 23.0.
   double reid_confidence = 0.99999;
   double min_iou = 0.3;  ///< image mode: minimum IoU to associate
-  /// Spectral density of the white acceleration noise. Metric: m^2/s^3 per axis. Image: per
-  /// unit box height squared (1/s^3), so it scales with the object's apparent size.
+  /// Spectral density of the white acceleration noise. Metric: m^2/s^3 per axis. Image: box
+  /// heights^2/s^3 (px^2/s^3 per px^2 of box height), so it scales with the apparent size.
   double accel_psd = 0.5;
-  /// Metric: m, position noise of detections without a covariance. Image: fraction of the box
-  /// height (SORT-like 1/20).
+  /// Metric: m, position noise of detections without a covariance. Image: box heights (std of
+  /// each of centre x, centre y, width and height in px per px of box height).
   double measurement_std = 0.1;
   double initial_velocity_std = 1.0;  ///< m/s (metric) or box heights/s (image)
-  int min_hits = 3;                   ///< updates before a track is confirmed
-  double max_age_s = 1.5;             ///< s a confirmed track coasts without detections
-  double high_score = 0.5;            ///< detections at or above: first pass, may start tracks
-  double low_score = 0.1;             ///< below: ignored; in between: second pass only
-  bool second_pass = true;            ///< ByteTrack's low-score association
-  bool class_aware = true;            ///< tracks only take detections of their class
+  /// Updates before a track is confirmed; a tentative track that misses one is dropped. Image
+  /// default 2 (see defaultsFor).
+  int min_hits = 3;
+  double max_age_s = 1.5;   ///< s a confirmed track coasts without detections (both modes)
+  double high_score = 0.5;  ///< detections at or above: first pass, may start tracks
+  double low_score = 0.1;   ///< below: ignored; in between: second pass only
+  bool second_pass = true;  ///< ByteTrack's low-score association
+  bool class_aware = true;  ///< tracks only take detections of their class
 
   /// Empty if valid, else the reason.
   std::string validate() const;
+
+  /// The documented defaults of a mode. Metric: the member initialisers. Image (chosen on the
+  /// pinhole scenes of sim.image_scene, several seeds, 25 and 30 fps; README "Tracking core"):
+  /// the same noise levels read in box heights, and min_hits 2, because with 3 a person who is
+  /// missed once in the first frames is dropped and found again frames later (recall).
+  static TrackerConfig defaultsFor(Mode mode);
+  /// The parameters whose default in `mode` differs from the metric one, by their YAML / field
+  /// name, with the mode's value: what a node applies to the keys its user left unset.
+  static std::vector<std::pair<std::string, double>> modeSpecificDefaults(Mode mode);
 };
 
 struct Track {

@@ -37,6 +37,9 @@ class TrackerRos {
 
  private:
   void reconfigure(TrackerNodeConfig& cfg, std::uint32_t level);
+  /// Writes the mode's own defaults (TrackerConfig::modeSpecificDefaults) to the private
+  /// parameters the user left unset, before the reconfigure server reads them; logs which.
+  void applyModeDefaults(TrackerConfig::Mode mode);
   void onDetections(const DetectedObjectArrayConstPtr& msg);
   void onTfFailure(const DetectedObjectArrayConstPtr& msg,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason);
