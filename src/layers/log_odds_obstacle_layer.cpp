@@ -11,6 +11,7 @@
 #include "downstream_perception/layers/observation/laser_scan_source.h"
 #include "downstream_perception/layers/observation/point_cloud_source.h"
 #include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/timing_diagnostics.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
 
 namespace downstream_perception {
@@ -644,6 +645,7 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     status.add(p + "transform age at integration max (s)", h.transform_age_s.max);
     status.add(p + "integration time mean (ms)", h.integrate_ms.mean());
     status.add(p + "integration time max (ms)", h.integrate_ms.max);
+    addTimingHistogram(status, p + "integration time", "ms", h.integrate_ms.histogram);
     status.add(p + "last message cells cleared", h.last.cells_cleared);
     status.add(p + "last message cells marked", h.last.cells_marked);
     status.add(p + "clear:mark ratio (last message)", h.last.clearMarkRatio());

@@ -6,6 +6,7 @@ be replayed fail before anything starts with a reason and exit status 2."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -107,6 +108,34 @@ def test_the_map_loads_back_into_the_static_layer(replayed: Path) -> None:
     report = (replayed / "report.md").read_text()
     assert "x real time" in report and "`/scan`" in report
     assert "data:image/png;base64," in (replayed / "report.html").read_text()
+
+
+def test_the_report_plots_processing_times(replayed: Path) -> None:
+    png = replayed / "processing_times.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    report = (replayed / "report.md").read_text()
+    assert "Processing time per message" in report
+    # The obstacle source's and the costmap's percentiles, from their whole-run histograms.
+    assert re.search(r"integration time p99 \(ms\): [0-9.e+-]+", report), report
+    assert re.search(r"update time p50 \(ms\): [0-9.e+-]+", report), report
+
+
+def test_processing_histograms_read_the_nodelets_encoding() -> None:
+    from downstream_perception.replay import outputs
+
+    diagnostics = {
+        "/costmap: costmap: update time histogram (ms)": "0.562-1:3 1-1.78:2",
+        "/tracker: tracker: step time histogram (us)": "10-17.8:4 1e+05-inf:1",
+        "/costmap: costmap: update time p50 (ms)": "1",
+    }
+    h = outputs.processing_histograms(diagnostics)
+    assert set(h) == {"/costmap: costmap: update time", "/tracker: tracker: step time"}
+    assert h["/costmap: costmap: update time"] == [(0.562, 1.0, 3), (1.0, 1.78, 2)]
+    tracker = h["/tracker: tracker: step time"]  # us -> ms
+    assert tracker[0] == pytest.approx((0.01, 0.0178, 4))
+    assert tracker[1][1] == float("inf") and tracker[1][2] == 1
+    with pytest.raises(ValueError):
+        outputs.parse_histogram("1-2")
 
 
 def _refused(tmp_path: Path, bag: Path, capsys: pytest.CaptureFixture[str]) -> str:

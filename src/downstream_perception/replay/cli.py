@@ -22,7 +22,7 @@ from downstream_perception.replay.run import ReplayOptions, ReplayResult, replay
 OUTPUTS = [
     Path(name)
     for name in ("costmap.pgm", "costmap.yaml", "tracks.csv", "mesh.ply", "octomap.bt", "map.png",
-                 "transform_ages.png", "report.md", "report.html")
+                 "transform_ages.png", "processing_times.png", "report.md", "report.html")
 ]  # fmt: skip
 
 DESCRIPTION = """Replay a recorded bag through the same nodelets and YAML as on the robot, and
@@ -99,6 +99,10 @@ def write_outputs(out: Path, pipeline: Pipeline, summary: BagSummary, result: Re
     ages = outputs.render_histograms(summary.transform_ages_s, out / "transform_ages.png")
     if ages is not None:
         images.append(("Transform ages", ages))
+    histograms = outputs.processing_histograms(result.diagnostics)
+    times = outputs.render_processing_times(histograms, out / "processing_times.png")
+    if times is not None:
+        images.append(("Processing time per message", times))
     md, _ = outputs.write_report(out, report_lines(pipeline, summary, result, files), images)
     return md
 
@@ -136,9 +140,21 @@ def report_lines(
     }
     lines += ["", "## Rejections (diagnostics)", ""]
     lines += [f"- {k}: {v}" for k, v in sorted(rejected.items())] or ["- none"]
-    words = ("integration time", "transform age", "messages received", "integrated", "time (ms)")
-    timing = {k: v for k, v in result.diagnostics.items() if any(w in k for w in words)}
-    lines += ["", "## Processing (diagnostics: counts, means and maxima)", ""]
+    words = (
+        "integration time",
+        "transform age",
+        "messages received",
+        "integrated",
+        "time (ms)",
+        " p50 (",
+        " p99 (",
+    )
+    timing = {
+        k: v
+        for k, v in result.diagnostics.items()
+        if any(w in k for w in words) and "histogram" not in k  # the histograms are plotted
+    }
+    lines += ["", "## Processing (diagnostics: counts, means, maxima and percentiles)", ""]
     lines += [f"- {k}: {v}" for k, v in sorted(timing.items())] or ["- none reported"]
     lines += ["", "## Files", ""] + [f"- {k}: `{p.name}`" for k, p in files.items()]
     return lines

@@ -6,6 +6,7 @@ from __future__ import annotations
 import base64
 import csv
 import html
+import re
 from pathlib import Path
 from typing import Any
 
@@ -198,6 +199,57 @@ def render_histograms(ages: dict[str, list[float]], out: Path) -> Path | None:
     ax.set_xlabel("message stamp - newest /tf stamp recorded before it (ms)")
     ax.set_ylabel("messages")
     ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+    return out
+
+
+HISTOGRAM_BIN = re.compile(r"^([0-9.e+]+)-([0-9.e+]+|inf):([0-9]+)$")
+HISTOGRAM_KEY = re.compile(r"^(.*) histogram \((ms|us)\)$")
+
+
+def parse_histogram(text: str) -> list[tuple[float, float, int]]:
+    """A nodelet's LogHistogram::encode() ("lower-upper:count ...") as (lower, upper, count)."""
+    bins = []
+    for item in text.split():
+        m = HISTOGRAM_BIN.match(item)
+        if m is None:
+            raise ValueError(f"not a histogram bin: {item!r}")
+        bins.append((float(m.group(1)), float(m.group(2)), int(m.group(3))))
+    return bins
+
+
+def processing_histograms(diagnostics: dict[str, str]) -> dict[str, list[tuple[float, float, int]]]:
+    """Every "<name> histogram (ms|us)" the nodelets reported, in ms, by "<status>: <name>"."""
+    out = {}
+    for key, value in diagnostics.items():
+        m = HISTOGRAM_KEY.match(key)
+        if m is None or not value:
+            continue
+        scale = 1e-3 if m.group(2) == "us" else 1.0
+        out[m.group(1)] = [(lo * scale, hi * scale, n) for lo, hi, n in parse_histogram(value)]
+    return out
+
+
+def render_processing_times(
+    histograms: dict[str, list[tuple[float, float, int]]], out: Path
+) -> Path | None:
+    """Per-message processing time of each nodelet (and observation source), whole replay."""
+    if not histograms:
+        return None
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    for name, bins in sorted(histograms.items()):
+        # Overflow bins have no finite upper edge: drawn one bin wide.
+        edges = [(lo, hi if np.isfinite(hi) else lo * 10**0.25, n) for lo, hi, n in bins]
+        xs = np.array([[max(lo, 1e-4), hi] for lo, hi, _ in edges]).ravel()
+        ys = np.repeat([n for _, _, n in edges], 2)
+        ax.step(xs, ys, where="post", label=name)
+    ax.set_xscale("log")
+    ax.set_xlabel("processing time per message or update (ms, 4 bins per decade)")
+    ax.set_ylabel("messages")
+    ax.legend(fontsize="small")
     fig.tight_layout()
     fig.savefig(out, dpi=100)
     plt.close(fig)

@@ -8,6 +8,7 @@
 
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/conversions.h"
+#include "downstream_perception/ros/common/timing_diagnostics.h"
 #include "downstream_perception/ros/costmap/costmap_plugin_list.h"
 #include "downstream_perception/ros/costmap/footprint_params.h"
 
@@ -388,6 +389,7 @@ void CostmapRos::diagnoseCostmap(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("update time last (ms)", update_time_ms_.last);
   status.add("update time mean (ms)", update_time_ms_.mean());
   status.add("update time max (ms)", update_time_ms_.max);
+  addTimingHistogram(status, "update time", "ms", update_time_ms_.histogram);
   status.add("updates skipped (previous still running)", updates_skipped_busy_);
   status.add("update on data", config_.update_on_data);
   if (data_to_publish_ms_.total() > 0) {

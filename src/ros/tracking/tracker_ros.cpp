@@ -10,6 +10,7 @@
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/tf_failure.h"
+#include "downstream_perception/ros/common/timing_diagnostics.h"
 
 namespace downstream_perception {
 
@@ -281,6 +282,7 @@ void TrackerRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("ID switches vs truth ids (total)", total_.id_switches);
   status.add("step time mean (us)", step_us_.mean());
   status.add("step time max (us)", step_us_.max);
+  addTimingHistogram(status, "step time", "us", step_us_.histogram);
   const std::vector<std::string> config_errors = config_errors_.all();
   addConfigErrors(status, config_errors);
   const std::size_t waiting = addTfWaits(status, "", filtered_.waitingForTf());

@@ -16,6 +16,7 @@
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/common/save_service.h"
 #include "downstream_perception/ros/common/tf_failure.h"
+#include "downstream_perception/ros/common/timing_diagnostics.h"
 #include "downstream_perception/ros/tsdf/tsdf_params.h"
 #include "downstream_perception/ros/tsdf/tsdf_slice_messages.h"
 
@@ -419,6 +420,7 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("frames rejected", rejected);
   status.add("integration time mean (ms)", integrate_ms_.mean());
   status.add("integration time max (ms)", integrate_ms_.max);
+  addTimingHistogram(status, "integration time", "ms", integrate_ms_.histogram);
   status.add("last frame: valid pixels or points", last_.pixels_valid);
   status.add("last frame: voxels updated", last_.voxels_updated);
   status.add("invalid pixels or points (total)", pixels_invalid_);

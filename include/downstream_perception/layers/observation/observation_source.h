@@ -75,7 +75,7 @@ class ObservationSource {
     std::size_t integrated = 0;
     std::map<std::string, std::size_t> notes;  ///< accepted, but e.g. de-skew skipped
     RunningStats transform_age_s;              ///< now - stamp when integrated
-    RunningStats integrate_ms;
+    TimingStats integrate_ms;
     IntegrationStats last;   ///< the last message's integration
     IntegrationStats total;  ///< since start
     ros::WallTime last_received;

@@ -88,7 +88,7 @@ class CostmapRos {
   ros::Time last_publish_;
   ClockJumpDetector clock_jump_;
   ros::Time last_update_;
-  RunningStats update_time_ms_;
+  TimingStats update_time_ms_;
   RunningStats update_period_s_;
   std::size_t updates_ = 0;
   std::size_t clears_ = 0;

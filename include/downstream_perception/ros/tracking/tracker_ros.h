@@ -77,7 +77,7 @@ class TrackerRos {
   ClockJumpDetector clock_jump_;
   std::size_t detections_unknown_kind_ = 0;
   ros::SteadyTimer clock_watch_;
-  RunningStats step_us_;
+  TimingStats step_us_;
   ConfigErrorLog config_errors_{"tracker"};
 };
 

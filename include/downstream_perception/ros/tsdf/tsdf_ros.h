@@ -123,7 +123,7 @@ class TsdfRos {
   std::size_t blocks_refused_ = 0;
   std::size_t blocks_evicted_ = 0;
   std::size_t pixels_no_return_ignored_ = 0;  ///< +Inf pixels carving refused to use (total)
-  RunningStats integrate_ms_;
+  TimingStats integrate_ms_;
   RunningStats mesh_ms_;
   std::size_t mesh_triangles_ = 0;
   double health_period_s_ = 10.0;
