@@ -133,6 +133,48 @@ TEST(Esdf, IncrementalUpdatesOfARealSequenceMatchTheOracle) {
   }
 }
 
+TEST(Esdf, AChangeIsRecomputedOnlyWithinReach) {
+  // A 6.4 x 6.4 m floor at 10 cm (max distance 0.5 m: 6 voxels, so a change reaches one
+  // block further); then a small post appears in one block. Only the blocks within reach of that
+  // block are recomputed, from a region of them plus one block of seeds, and the field is exact.
+  TsdfConfig tc;
+  tc.voxel_size_m = 0.1;
+  TsdfMap map(tc);
+  const double mu = tc.truncation();
+  const auto floor = [&](const Eigen::Vector3d& p) {
+    return std::clamp((p.z() - 0.037) / mu, -1.0, 1.0);
+  };
+  fill(&map, {-32, -32, -8}, {31, 31, 15}, floor);
+  EsdfConfig c;
+  c.max_distance_m = 0.5;
+  Esdf esdf(c, 0.1);
+  EXPECT_TRUE(esdf.update(map).full);
+  EXPECT_EQ(esdf.update(map).blocks_written, 0u);  // nothing integrated: nothing recomputed
+  // The post: voxels (2..3, 2..3, 1..5) become occupied; only their block is stamped.
+  const std::uint64_t generation = map.beginIntegration();
+  for (int z = 1; z <= 5; ++z) {
+    for (int y = 2; y <= 3; ++y) {
+      for (int x = 2; x <= 3; ++x) {
+        const Eigen::Vector3i v(x, y, z);
+        map.find(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)].distance = -0.1f;
+      }
+    }
+  }
+  map.find({0, 0, 0})->updated_stamp = generation;
+  const EsdfUpdateStats stats = esdf.update(map);
+  EXPECT_FALSE(stats.full);
+  EXPECT_EQ(stats.blocks_read, 1u);
+  EXPECT_EQ(stats.voxels_changed, 20u);
+  // Blocks within one block of block (0, 0, 0) that exist: 3 x 3 x 3 (z blocks -1..1 exist).
+  EXPECT_EQ(stats.blocks_written, 27u);
+  EXPECT_EQ(stats.region_voxels, std::size_t{5 * 5 * 3} * kTsdfBlockVoxels);  // + 1 block of seeds
+  EXPECT_EQ(compareWithOracle(map, esdf).off, 0u);
+  // One voxel above the post's top voxel (z index 5): (1 - 1/2) * 0.1 m; two voxels beside it
+  // (x index 5): (2 - 1/2) * 0.1 m (the floor is 3 voxels below).
+  EXPECT_FLOAT_EQ(esdf.voxelDistance({2, 2, 6}), 0.05f);
+  EXPECT_FLOAT_EQ(esdf.voxelDistance({5, 2, 3}), 0.15f);
+}
+
 TEST(Esdf, EvictedAndClearedBlocksLeaveTheField) {
   TsdfMap map = filledRoom(0.1, RoomScene{});
   EsdfConfig c;
