@@ -82,7 +82,11 @@ void bindEsdf(py::module& m) {
           [](Tsdf& self, const EsdfConfig& c) {
             const std::string why = c.validate(self.map.voxelSize());
             if (!why.empty()) throw std::invalid_argument(why);
-            esdfOf(self).setConfig(c);
+            if (self.esdf) {
+              self.esdf->setConfig(c);
+            } else {  // not through esdfOf: the defaults may not suit this voxel size
+              self.esdf = std::make_unique<Esdf>(c, self.map.voxelSize());
+            }
           },
           py::arg("config"), "Raises ValueError if invalid; the next esdf_update is full.")
       .def(
