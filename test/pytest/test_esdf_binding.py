@@ -82,6 +82,14 @@ def test_incremental_esdf_matches_scipy_exact_edt_with_a_box_taken_away() -> Non
     stats = integrate(tsdf, without_box, poses)
     assert sum(s.voxels_changed for s in stats) > 1000
     assert oracle_mismatches(tsdf)[0] == 0
+    # The incremental field is the one a full recomputation gives, voxel for voxel.
+    incremental = tsdf.esdf_voxels()
+    assert tsdf.esdf_recompute().full
+    full = tsdf.esdf_voxels()
+    order_i = np.lexsort(incremental["voxels"].T)
+    order_f = np.lexsort(full["voxels"].T)
+    np.testing.assert_array_equal(incremental["voxels"][order_i], full["voxels"][order_f])
+    np.testing.assert_array_equal(incremental["distance"][order_i], full["distance"][order_f])
     # The box's centre was inside it; now it is free space.
     d, _ = tsdf.esdf_distance(np.array([[0.8073, 0.5959, 0.3529]]))
     assert d[0] > 0.0
