@@ -13,9 +13,8 @@
 namespace downstream_perception {
 
 namespace {
-/// Regions are split into tiles of this many blocks per axis when one region over every block
-/// to write would hold more voxels than the tiles together (scattered changes), or more than
-/// kMaxRegionVoxels: this bounds the scratch memory.
+/// A cluster of blocks to write whose region would hold more than kMaxRegionVoxels is split into
+/// tiles of this many blocks per axis: this bounds the scratch memory.
 constexpr int kTileBlocks = 8;
 constexpr std::size_t kMaxRegionVoxels = std::size_t{1} << 24;
 /// Largest dense block grid used to mark the blocks within reach of a change.
@@ -37,6 +36,29 @@ std::size_t volume(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) {
 /// floor(a / b) for b > 0.
 int floorDiv(int a, int b) {
   return a >= 0 ? a / b : -1 - (-(a + 1)) / b;
+}
+/// The blocks in 26-connected clusters (breadth-first over the block grid).
+std::vector<std::vector<Eigen::Vector3i>> connectedClusters(
+    const std::vector<Eigen::Vector3i>& keys) {
+  tsl::robin_set<Eigen::Vector3i, BlockIndexHash> left(keys.begin(), keys.end());
+  std::vector<std::vector<Eigen::Vector3i>> clusters;
+  for (const Eigen::Vector3i& seed : keys) {
+    if (left.erase(seed) == 0) continue;
+    std::vector<Eigen::Vector3i> cluster{seed};
+    for (std::size_t i = 0; i < cluster.size(); ++i) {
+      const Eigen::Vector3i k = cluster[i];
+      for (int z = -1; z <= 1; ++z) {
+        for (int y = -1; y <= 1; ++y) {
+          for (int x = -1; x <= 1; ++x) {
+            const Eigen::Vector3i n = k + Eigen::Vector3i(x, y, z);
+            if (left.erase(n) != 0) cluster.push_back(n);
+          }
+        }
+      }
+    }
+    clusters.push_back(std::move(cluster));
+  }
+  return clusters;
 }
 }  // namespace
 
@@ -147,41 +169,41 @@ EsdfUpdateStats Esdf::run(const TsdfMap& map, bool full) {
   if (write.empty()) return stats;
   stats.blocks_written = write.size();
 
-  // One region over all blocks to write, unless tiles together are smaller (scattered changes).
+  computeRegions(write, extent, &stats);
+  return stats;
+}
+
+void Esdf::computeRegions(const std::vector<Eigen::Vector3i>& write, const BlockBox& extent,
+                          EsdfUpdateStats* stats) {
+  // Each cluster of blocks to write is one region (scattered changes give small separate ones),
+  // unless that region would hold more than kMaxRegionVoxels: then its tiles are.
   const int margin = (radius_voxels_ - 1) / kTsdfBlockSide + 1;  // blocks of seeds around them
-  const auto sourceVolume = [&](const BlockBox& b) {
-    return volume((b.lo - Eigen::Vector3i::Constant(margin)).cwiseMax(extent.lo),
-                  (b.hi + Eigen::Vector3i::Constant(margin)).cwiseMin(extent.hi)) *
-           kTsdfBlockVoxels;
-  };
-  BlockBox all{write.front(), write.front()};
-  tsl::robin_map<Eigen::Vector3i, std::vector<Eigen::Vector3i>, BlockIndexHash> tiles;
-  for (const Eigen::Vector3i& key : write) {
-    all.lo = all.lo.cwiseMin(key);
-    all.hi = all.hi.cwiseMax(key);
-    const Eigen::Vector3i tile(floorDiv(key.x(), kTileBlocks), floorDiv(key.y(), kTileBlocks),
-                               floorDiv(key.z(), kTileBlocks));
-    tiles[tile].push_back(key);
-  }
-  std::size_t tiled = 0;
-  std::vector<BlockBox> tile_boxes;
-  for (const auto& [tile, keys] : tiles) {
+  const auto boundsOf = [](const std::vector<Eigen::Vector3i>& keys) {
     BlockBox b{keys.front(), keys.front()};
     for (const Eigen::Vector3i& k : keys) {
       b.lo = b.lo.cwiseMin(k);
       b.hi = b.hi.cwiseMax(k);
     }
-    tile_boxes.push_back(b);
-    tiled += sourceVolume(b);
+    return b;
+  };
+  for (const std::vector<Eigen::Vector3i>& cluster : connectedClusters(write)) {
+    const BlockBox box = boundsOf(cluster);
+    const std::size_t voxels =
+        volume((box.lo - Eigen::Vector3i::Constant(margin)).cwiseMax(extent.lo),
+               (box.hi + Eigen::Vector3i::Constant(margin)).cwiseMin(extent.hi)) *
+        kTsdfBlockVoxels;
+    if (voxels <= kMaxRegionVoxels) {
+      computeRegion(box, cluster, extent, stats);
+      continue;
+    }
+    tsl::robin_map<Eigen::Vector3i, std::vector<Eigen::Vector3i>, BlockIndexHash> tiles;
+    for (const Eigen::Vector3i& key : cluster) {
+      tiles[Eigen::Vector3i(floorDiv(key.x(), kTileBlocks), floorDiv(key.y(), kTileBlocks),
+                            floorDiv(key.z(), kTileBlocks))]
+          .push_back(key);
+    }
+    for (const auto& kv : tiles) computeRegion(boundsOf(kv.second), kv.second, extent, stats);
   }
-  const std::size_t merged = sourceVolume(all);
-  if (merged <= tiled && merged <= kMaxRegionVoxels) {
-    computeRegion(all, write, extent, &stats);
-  } else {
-    std::size_t i = 0;
-    for (const auto& [tile, keys] : tiles) computeRegion(tile_boxes[i++], keys, extent, &stats);
-  }
-  return stats;
 }
 
 std::vector<Eigen::Vector3i> Esdf::blocksToWrite(const std::vector<Eigen::Vector3i>& changed,

@@ -96,11 +96,15 @@ struct OracleComparison {
 /// <= min_weight; occupied: D < 0; else free), and for every known voxel the smallest squared
 /// lattice distance to a voxel of the other known state, by scanning every voxel of the cube
 /// of the ESDF's radius around it (seeds farther away give the clamp anyway).
-inline OracleComparison compareWithOracle(const TsdfMap& map, const Esdf& esdf) {
+/// `near_block`, if given, restricts the comparison to the bounding box of the blocks within 16
+/// blocks of it (for maps of patches farther apart than that and than the ESDF's reach).
+inline OracleComparison compareWithOracle(const TsdfMap& map, const Esdf& esdf,
+                                          const Eigen::Vector3i* near_block = nullptr) {
   OracleComparison result;
   if (map.blockCount() == 0) return result;
   Eigen::Vector3i lo = Eigen::Vector3i::Constant(INT_MAX), hi = Eigen::Vector3i::Constant(INT_MIN);
   for (const auto& kv : map.blocks()) {
+    if (near_block != nullptr && (kv.first - *near_block).cwiseAbs().maxCoeff() > 16) continue;
     lo = lo.cwiseMin(kv.first * kTsdfBlockSide);
     hi = hi.cwiseMax(kv.first * kTsdfBlockSide + Eigen::Vector3i::Constant(kTsdfBlockSide - 1));
   }

@@ -175,6 +175,48 @@ TEST(Esdf, AChangeIsRecomputedOnlyWithinReach) {
   EXPECT_FLOAT_EQ(esdf.voxelDistance({5, 2, 3}), 0.15f);
 }
 
+TEST(Esdf, ScatteredChangesAreRecomputedAsSeparateRegions) {
+  // Two floor patches 200 blocks apart (160 m at 10 cm), then a post appears on each: the blocks
+  // within reach of the two are found without dense marks (200^3 blocks), each post's
+  // neighbourhood is its own region, and both match the oracle.
+  TsdfConfig tc;
+  tc.voxel_size_m = 0.1;
+  TsdfMap map(tc);
+  const double mu = tc.truncation();
+  const Eigen::Vector3i far_block(200, 200, 200);
+  const Eigen::Vector3i far = far_block * kTsdfBlockSide;
+  for (const Eigen::Vector3i& o : {Eigen::Vector3i::Zero().eval(), far}) {
+    const double floor_z = (o.z() + 0.37) * 0.1;
+    fill(&map, o + Eigen::Vector3i(-16, -16, -8), o + Eigen::Vector3i(15, 15, 15),
+         [&](const Eigen::Vector3d& p) { return std::clamp((p.z() - floor_z) / mu, -1.0, 1.0); });
+  }
+  EsdfConfig c;
+  c.max_distance_m = 0.5;
+  Esdf esdf(c, 0.1);
+  EXPECT_TRUE(esdf.update(map).full);
+  const std::uint64_t generation = map.beginIntegration();
+  for (const Eigen::Vector3i& o : {Eigen::Vector3i::Zero().eval(), far}) {
+    for (int z = 1; z <= 5; ++z) {
+      const Eigen::Vector3i v = o + Eigen::Vector3i(2, 2, z);
+      map.find(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)].distance = -0.1f;
+    }
+    map.find(TsdfMap::blockOf(o))->updated_stamp = generation;
+  }
+  const EsdfUpdateStats stats = esdf.update(map);
+  EXPECT_FALSE(stats.full);
+  EXPECT_EQ(stats.voxels_changed, 10u);
+  EXPECT_EQ(stats.blocks_written, 54u);  // 27 around each post
+  EXPECT_EQ(stats.regions, 2u);
+  for (const Eigen::Vector3i& b : {Eigen::Vector3i::Zero().eval(), far_block}) {
+    const OracleComparison o = compareWithOracle(map, esdf, &b);
+    EXPECT_EQ(o.off, 0u);
+    EXPECT_GT(o.known, 20000u);
+  }
+  // Beside each post, two voxels away: (2 - 1/2) * 0.1 m.
+  EXPECT_FLOAT_EQ(esdf.voxelDistance({4, 2, 3}), 0.15f);
+  EXPECT_FLOAT_EQ(esdf.voxelDistance(far + Eigen::Vector3i(4, 2, 3)), 0.15f);
+}
+
 TEST(Esdf, EvictedAndClearedBlocksLeaveTheField) {
   TsdfMap map = filledRoom(0.1, RoomScene{});
   EsdfConfig c;

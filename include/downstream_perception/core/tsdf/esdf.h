@@ -118,6 +118,8 @@ class Esdf {
                         std::vector<Eigen::Vector3i>* changed);
   std::vector<Eigen::Vector3i> blocksToWrite(const std::vector<Eigen::Vector3i>& changed,
                                              const BlockBox& extent) const;
+  void computeRegions(const std::vector<Eigen::Vector3i>& write, const BlockBox& extent,
+                      EsdfUpdateStats* stats);
   void computeRegion(const BlockBox& write_box, const std::vector<Eigen::Vector3i>& write_blocks,
                      const BlockBox& extent, EsdfUpdateStats* stats);
 
