@@ -1,5 +1,6 @@
 """TSDF benchmark (report, never assert): integration ms per frame, meshing, memory and accuracy on
-the simulated room (30 frames on a circle), at 320x240 and 640x480, 2 cm and 5 cm voxels.
+the simulated room (30 frames on a circle), at 320x240 and 640x480, 2 cm and 5 cm voxels; the ESDF
+(incremental update per frame and full recomputation) at 5 cm.
 
 Used by bench.py; runnable alone: python3 bench/bench_tsdf.py
 """
@@ -118,6 +119,57 @@ def run(frames: int = 30) -> list[dict[str, Any]]:
                 "carve_mb": tsdf.memory_bytes / 1e6,
             }
         )
+    rows += esdf_rows(scene, poses, frames["320x240"])
+    return rows
+
+
+def esdf_rows(
+    scene: Any, poses: list[np.ndarray], camera_and_depths: tuple[Any, list[np.ndarray]]
+) -> list[dict[str, Any]]:
+    """ESDF at 5 cm on the 320x240 room: esdf_update() after every frame (the first is full),
+    then a full recomputation, each next to the frame's integration time."""
+    import downstream_perception as dp
+
+    cam, depths = camera_and_depths
+    pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
+    rows = []
+    for carve in (False, True):
+        config = dp.TsdfConfig()
+        config.voxel_size_m = 0.05
+        config.carve_free_space = carve
+        tsdf = dp.Tsdf(config)
+        integrate_ms, update_ms, changed = [], [], []
+        for pose, depth in zip(poses, depths, strict=True):
+            t0 = time.perf_counter()
+            tsdf.integrate_depth(depth, pinhole, pose)
+            t1 = time.perf_counter()
+            stats = tsdf.esdf_update()
+            t2 = time.perf_counter()
+            integrate_ms.append(1e3 * (t1 - t0))
+            update_ms.append(1e3 * (t2 - t1))
+            changed.append(stats.voxels_changed)
+        full_ms = []
+        for _ in range(3):
+            t0 = time.perf_counter()
+            tsdf.esdf_recompute()
+            full_ms.append(1e3 * (time.perf_counter() - t0))
+        incremental = update_ms[1:]  # the first update is the full one
+        rows.append(
+            {
+                "esdf_voxel_m": 0.05,
+                "esdf_carving": carve,
+                "esdf_max_distance_m": tsdf.esdf_config.max_distance_m,
+                "esdf_integrate_median_ms": float(np.median(integrate_ms)),
+                "esdf_update_median_ms": float(np.median(incremental)),
+                "esdf_update_p90_ms": float(np.percentile(incremental, 90)),
+                "esdf_update_max_ms": float(np.max(incremental)),
+                "esdf_voxels_changed_median": float(np.median(changed[1:])),
+                "esdf_full_median_ms": float(np.median(full_ms)),
+                "esdf_blocks": int(tsdf.esdf_block_count),
+                "esdf_mb": tsdf.esdf_memory_bytes / 1e6,
+                "esdf_tsdf_mb": tsdf.memory_bytes / 1e6,
+            }
+        )
     return rows
 
 
@@ -166,6 +218,27 @@ def markdown(rows: list[dict[str, Any]]) -> list[str]:
                 f"{r['carve_integrate_median_ms']:.1f} ms per frame, {r['carve_blocks']} blocks, "
                 f"{r['carve_mb']:.1f} MB.",
             ]
+    esdf = [r for r in rows if "esdf_voxel_m" in r]
+    if esdf:
+        lines += [
+            "",
+            "ESDF (exact, from the TSDF; 320x240, 5 cm, max distance "
+            f"{esdf[0]['esdf_max_distance_m']:.1f} m): esdf_update() after each of the 30 frames "
+            "(the first, full, left out), then a full recomputation (median of 3). Goal: "
+            "<= 10 ms per incremental update, <= 50 ms full.",
+            "",
+            "| TSDF | integrate ms | ESDF update ms median / p90 / max | voxels changed per "
+            "frame (median) | full ESDF ms | blocks | ESDF MB (TSDF MB) |",
+            "|---|---|---|---|---|---|---|",
+        ]
+        for r in esdf:
+            lines.append(
+                f"| {'carving' if r['esdf_carving'] else 'band only'} | "
+                f"{r['esdf_integrate_median_ms']:.2f} | {r['esdf_update_median_ms']:.2f} / "
+                f"{r['esdf_update_p90_ms']:.2f} / {r['esdf_update_max_ms']:.2f} | "
+                f"{r['esdf_voxels_changed_median']:.0f} | {r['esdf_full_median_ms']:.2f} | "
+                f"{r['esdf_blocks']} | {r['esdf_mb']:.1f} ({r['esdf_tsdf_mb']:.1f}) |"
+            )
     lines.append("")
     return lines
 

@@ -54,6 +54,8 @@ try:
         NO_INFORMATION,
         CorrectionMonitor,
         CorrectionMonitorConfig,
+        EsdfConfig,
+        EsdfUpdateStats,
         GridGeometry,
         InflationConfig,
         IntegrationStats,

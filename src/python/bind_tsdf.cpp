@@ -17,19 +17,13 @@
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "tsdf_object.h"
 
 namespace py = pybind11;
 using namespace downstream_perception;  // NOLINT
+using downstream_perception::python::Tsdf;
 
 namespace {
-
-/// The map and its incremental mesher, as one Python object.
-struct Tsdf {
-  explicit Tsdf(const TsdfConfig& config) : map(config) {}
-  TsdfMap map;
-  DepthIntegrator integrator;
-  TsdfMesher mesher;
-};
 
 Eigen::Isometry3d toIsometry(const Eigen::Matrix4d& m) {
   if (!m.allFinite() || (m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9) {

@@ -6,6 +6,7 @@
 namespace py = pybind11;
 
 void bindTsdf(py::module& m);      // bind_tsdf.cpp
+void bindEsdf(py::module& m);      // bind_esdf.cpp (adds to bindTsdf's Tsdf)
 void bindGrid(py::module& m);      // bind_grid.cpp
 void bindCostmap(py::module& m);   // bind_costmap.cpp
 void bindTracking(py::module& m);  // bind_tracking.cpp
@@ -16,6 +17,7 @@ PYBIND11_MODULE(_core, m) {
   // The package refuses numpy 2 with a pybind11 older than 2.12 (see __init__.py).
   m.attr("pybind11_version") = py::make_tuple(PYBIND11_VERSION_MAJOR, PYBIND11_VERSION_MINOR);
   bindTsdf(m);
+  bindEsdf(m);
 
   bindGrid(m);
   bindCostmap(m);

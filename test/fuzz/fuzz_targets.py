@@ -1362,6 +1362,104 @@ def garbage_tsdf(a: dict[str, Any], r: Any) -> str | None:
     return None
 
 
+def gen_esdf(rng: np.random.Generator) -> dict[str, Any]:
+    g = Gen(rng, 0.2)
+    ops: list[tuple[Any, ...]] = []
+    for _ in range(int(rng.integers(1, 7))):
+        op = g.pick(("depth", "points", "update", "update", "recompute", "set_esdf", "clear"))
+        if op == "depth":
+            cam = camera_args(g)
+            ops.append((op, depth_args(g, cam["shape"]), cam, pose_matrix(g)))
+        elif op == "points":
+            ops.append((op, g.array((int(g.pick((0, 1, 50))), 3), -2, 4), g.array((3,), -1, 1)))
+        elif op == "set_esdf":
+            ops.append((op, g.f(0.1, 2.0, 0.3)))
+        else:
+            ops.append((op,))
+    return {
+        "config": tsdf_config_args(g),
+        "max_distance_m": g.f(0.1, 2.0, 0.3),
+        "ops": ops,
+        "query": sample_points(g),
+    }
+
+
+def call_esdf(a: dict[str, Any]) -> Any:
+    c = core()
+    config = make_tsdf_config(a["config"])
+    if config.validate():
+        return {"skipped": True}  # the Tsdf target covers invalid map configs
+    tsdf = c.Tsdf(config)
+    max_distance: list[float] = []  # the ESDF's accepted caps, last one current
+    problems: list[str] = []
+
+    def set_esdf(value: float) -> None:
+        e = c.EsdfConfig()
+        e.max_distance_m = value
+        valid = e.validate(config.voxel_size_m) == ""
+        try:
+            tsdf.set_esdf_config(e)
+            max_distance.append(value)
+            if not valid:
+                problems.append(f"set_esdf_config accepted max_distance_m {value}")
+        except ValueError as error:
+            if valid or not str(error):
+                raise
+
+    set_esdf(a["max_distance_m"])
+    for op in a["ops"]:
+        try:
+            if op[0] == "depth":
+                tsdf.integrate_depth(op[1], make_camera(op[2]), op[3])
+            elif op[0] == "points":
+                tsdf.integrate_points(op[1], op[2])
+            elif op[0] == "set_esdf":
+                set_esdf(op[1])
+            elif op[0] == "clear":
+                tsdf.clear()
+            elif max_distance:  # the default cap may not suit hostile voxel sizes
+                (tsdf.esdf_update if op[0] == "update" else tsdf.esdf_recompute)()
+        except (ValueError, TypeError, IndexError, RuntimeError) as error:
+            if not str(error):
+                raise
+    if not max_distance:
+        return {"skipped": True}
+    tsdf.esdf_update()
+    distance, gradient = tsdf.esdf_distance(a["query"])
+    voxels = tsdf.esdf_voxels()
+    return {
+        "problems": problems,
+        "max": max_distance[-1],
+        "distance": distance,
+        "gradient": gradient,
+        "voxel_distance": voxels["distance"],
+        "blocks": (tsdf.esdf_block_count, tsdf.block_count),
+    }
+
+
+def garbage_esdf(a: dict[str, Any], r: Any) -> str | None:
+    if r.get("skipped"):
+        return None
+    if r["problems"]:
+        return r["problems"][0]
+    if r["blocks"][0] > r["blocks"][1]:
+        return f"{r['blocks'][0]} ESDF blocks for {r['blocks'][1]} TSDF blocks"
+    v = r["voxel_distance"]
+    if not (np.isfinite(v) & (np.abs(v) <= r["max"] + 1e-6)).all():
+        return "a known ESDF voxel that is not finite or beyond the cap"
+    pts = np.asarray(a["query"], dtype=float)
+    d, g = r["distance"], r["gradient"]
+    if d.shape != (len(pts),) or g.shape != (len(pts), 3):
+        return f"esdf_distance shapes {d.shape}, {g.shape} for {len(pts)} points"
+    known = np.isfinite(d)
+    if (np.abs(d[known]) > r["max"] + 1e-6).any() or not np.isfinite(g[known]).all():
+        return "an interpolated distance beyond the cap or a non-finite gradient"
+    bad = ~np.isfinite(pts).all(axis=1) | (np.abs(pts).max(axis=1, initial=0) > 1e6)
+    if (bad & known).any():
+        return f"esdf_distance at {pts[bad & known][0].tolist()} is not NaN"
+    return None
+
+
 def gen_octree(rng: np.random.Generator) -> dict[str, Any]:
     g = Gen(rng, 0.15)
     config = {
@@ -1856,6 +1954,13 @@ def binding_targets() -> list[Target]:
             call_tsdf,
             garbage_tsdf,
             ("Tsdf", "TsdfConfig", "TsdfWeighting", "PinholeCamera"),
+        ),
+        Target(
+            "Esdf",
+            gen_esdf,
+            call_esdf,
+            garbage_esdf,
+            ("Tsdf", "EsdfConfig", "PinholeCamera"),
         ),
         Target(
             "OccupancyOctree",

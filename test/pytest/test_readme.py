@@ -55,6 +55,13 @@ def test_readme_tsdf_example_runs() -> None:
     assert weight[0] == 0.0 or distance[0] > 0.0
 
 
+def test_readme_esdf_example_runs() -> None:
+    namespace = next(ns for ns in run_blocks() if "esdf_stats" in ns)
+    assert not namespace["esdf_stats"].full  # the last of 8 updates was incremental
+    np.testing.assert_allclose(namespace["distance_m"], [0.075], atol=1e-6)
+    np.testing.assert_allclose(namespace["gradient"], [[0.0, 0.0, 1.0]], atol=1e-5)
+
+
 def test_readme_handoff_example_runs() -> None:
     namespace = next(ns for ns in run_blocks() if "corridor" in ns)
     corridor = namespace["corridor"]

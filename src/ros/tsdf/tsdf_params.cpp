@@ -70,6 +70,17 @@ TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog
                 " must be in [0, 100] m (0 = off); using 2");
     s.slice_distance_max_m = 2.0;
   }
+  pnh.param("esdf_max_distance_m", s.esdf_max_distance_m, s.esdf_max_distance_m);
+  if (!(std::isfinite(s.esdf_max_distance_m) && s.esdf_max_distance_m >= 0.0)) {
+    errors->add("parameter ~esdf_max_distance_m = " + toText(s.esdf_max_distance_m) +
+                " must be finite and >= 0 m (0 = no ESDF); using 1");
+    s.esdf_max_distance_m = 1.0;
+  }
+  pnh.param("esdf_slice_z_m", s.esdf_slice_z_m, s.esdf_slice_z_m);
+  if (!std::isfinite(s.esdf_slice_z_m)) {
+    errors->add("parameter ~esdf_slice_z_m must be finite; using 1");
+    s.esdf_slice_z_m = 1.0;
+  }
   pnh.param("tf_queue_size", s.tf_queue_size, s.tf_queue_size);
   if (s.tf_queue_size < 1 || s.tf_queue_size > 1000) {
     errors->add("parameter ~tf_queue_size must be in [1, 1000]; using 10");

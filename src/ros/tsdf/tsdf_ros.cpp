@@ -47,6 +47,16 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   slice_distance_max_m_ = settings.slice_distance_max_m;
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
   const OctomapSettings octomap = readOctomapSettings(pnh_, map_->config(), &config_errors_);
+  if (settings.esdf_max_distance_m > 0.0) {
+    EsdfConfig esdf;
+    esdf.max_distance_m = settings.esdf_max_distance_m;
+    const std::string why = esdf.validate(map_->voxelSize());
+    if (why.empty()) {
+      esdf_ = std::make_unique<EsdfRos>(pnh_, esdf, settings.esdf_slice_z_m, map_.get(), &mutex_);
+    } else {
+      config_errors_.add("parameter ~esdf_max_distance_m: " + why + "; no ESDF");
+    }
+  }
   if (octomap.enabled()) {  // ~octomap_resolution_m = 0 turns the OctoMap off
     octree_max_memory_bytes_ = octomap.octree.max_memory_bytes;
     octree_ = std::make_unique<OctreeWorker>(OccupancyOctree(octomap.octree),
@@ -292,7 +302,7 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   std::vector<SliceCell> slice_cells;
   GridGeometry slice_geometry;
   double slice_z = 0.0;
-  sensor_msgs::PointCloud2Ptr occupied;
+  sensor_msgs::PointCloud2Ptr occupied, esdf_slice;
   std_msgs::Header header;
   header.frame_id = world_frame_;
   header.stamp = ros::Time::now();
@@ -312,6 +322,7 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
       slice = sliceGridMessage(slice_cells, slice_geometry, slice_z, header);
       slice_changed_ = false;
     }
+    if (esdf_) esdf_slice = esdf_->sliceLocked(header);
     mesh_triangles_ = 0;
     for (const auto& kv : mesher_.blocks()) mesh_triangles_ += kv.second.triangleCount();
     // The health check walks the whole map (tens of ms): every health_period_s at most.
@@ -334,6 +345,7 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
                            slice_geometry, slice_z, header));
   }
   if (occupied) octomap_publisher_.publish(occupied);
+  if (esdf_slice) esdf_->publish(esdf_slice);
   returnFreeMemory();
   diagnostics_.update();
 }
@@ -458,6 +470,7 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     status.add("octomap: insertion time max (ms)", octree.insert_ms.max);
   }
   status.add("slice: free cells", slice_stats_.cells_free);
+  if (esdf_) esdf_->diagnose(status);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());
   if (!last_health_.isZero()) {
     status.add("health: zero crossings", health_.crossings);

@@ -31,6 +31,8 @@ struct TsdfNodeSettings {
   double health_period_s = 10.0;  ///< 0: no periodic health line
   TsdfSliceConfig slice;
   double slice_distance_max_m = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
+  double esdf_max_distance_m = 1.0;   ///< the ESDF's clamp (m); 0: no ESDF
+  double esdf_slice_z_m = 1.0;        ///< height of ~esdf_slice (m, world_frame)
   int tf_queue_size = 10;
 };
 TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog* errors);

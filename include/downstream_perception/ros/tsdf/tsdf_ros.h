@@ -41,6 +41,7 @@
 #include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/common/rejection_counter.h"
 #include "downstream_perception/ros/common/save_service.h"
+#include "downstream_perception/ros/tsdf/esdf_ros.h"
 #include "downstream_perception/ros/tsdf/tsdf_mesh_markers.h"
 
 namespace downstream_perception {
@@ -83,7 +84,8 @@ class TsdfRos {
   std::string world_frame_;
   std::mutex mutex_;  ///< guards the map, the mesher and the counters
   std::unique_ptr<TsdfMap> map_;
-  DepthIntegrator integrator_;  ///< keeps the per-pixel buffers between frames
+  std::unique_ptr<EsdfRos> esdf_;  ///< null with ~esdf_max_distance_m = 0; uses map_, mutex_
+  DepthIntegrator integrator_;     ///< keeps the per-pixel buffers between frames
   TsdfMesher mesher_;
   TsdfMeshMarkers markers_;
   std::map<std::string, sensor_msgs::CameraInfo> camera_infos_;  ///< latest per frame id

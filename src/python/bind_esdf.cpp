@@ -1,0 +1,141 @@
+// Python bindings of the ESDF: EsdfConfig, EsdfUpdateStats and the esdf_* methods of Tsdf
+// (registered by bindTsdf first), numpy batches in and out.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "downstream_perception/core/tsdf/esdf.h"
+#include "tsdf_object.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;  // NOLINT
+using downstream_perception::python::Tsdf;
+
+namespace {
+
+using PointRows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+Esdf& esdfOf(Tsdf& self) {
+  if (!self.esdf) self.esdf = std::make_unique<Esdf>(EsdfConfig{}, self.map.voxelSize());
+  return *self.esdf;
+}
+
+py::dict knownVoxels(const Esdf& esdf) {
+  py::ssize_t n = 0;
+  for (const auto& kv : esdf.blocks()) {
+    for (const std::uint8_t s : kv.second->state) n += s != 0;
+  }
+  py::array_t<std::int32_t> voxels({n, py::ssize_t{3}});
+  py::array_t<float> distance(n);
+  py::array_t<std::int8_t> occupied(n);
+  auto v = voxels.mutable_unchecked<2>();
+  auto d = distance.mutable_unchecked<1>();
+  auto o = occupied.mutable_unchecked<1>();
+  py::ssize_t i = 0;
+  for (const auto& [key, block] : esdf.blocks()) {
+    for (int k = 0; k < kTsdfBlockVoxels; ++k) {
+      if (block->state[k] == 0) continue;
+      const Eigen::Vector3i local(k % kTsdfBlockSide, k / kTsdfBlockSide % kTsdfBlockSide,
+                                  k / (kTsdfBlockSide * kTsdfBlockSide));
+      const Eigen::Vector3i voxel = key * kTsdfBlockSide + local;
+      for (int a = 0; a < 3; ++a) v(i, a) = voxel(a);
+      d(i) = block->distance[k];
+      o(i) = block->state[k] == static_cast<std::uint8_t>(EsdfState::kOccupied);
+      ++i;
+    }
+  }
+  py::dict out;
+  out["voxels"] = voxels;
+  out["distance"] = distance;
+  out["occupied"] = occupied;
+  return out;
+}
+
+}  // namespace
+
+void bindEsdf(py::module& m) {
+  py::class_<EsdfConfig>(m, "EsdfConfig")
+      .def(py::init<>())
+      .def_readwrite("max_distance_m", &EsdfConfig::max_distance_m,
+                     "distances are clamped at this (m); also a change's reach")
+      .def("validate", &EsdfConfig::validate, py::arg("voxel_size_m"));
+  py::class_<EsdfUpdateStats>(m, "EsdfUpdateStats")
+      .def_readonly("full", &EsdfUpdateStats::full)
+      .def_readonly("blocks_read", &EsdfUpdateStats::blocks_read)
+      .def_readonly("blocks_removed", &EsdfUpdateStats::blocks_removed)
+      .def_readonly("voxels_changed", &EsdfUpdateStats::voxels_changed)
+      .def_readonly("blocks_written", &EsdfUpdateStats::blocks_written)
+      .def_readonly("regions", &EsdfUpdateStats::regions)
+      .def_readonly("region_voxels", &EsdfUpdateStats::region_voxels);
+
+  auto tsdf = py::reinterpret_borrow<py::class_<Tsdf>>(m.attr("Tsdf"));
+  tsdf.def_property_readonly(
+          "esdf_config", [](Tsdf& self) { return esdfOf(self).config(); },
+          "The ESDF's settings (EsdfConfig's defaults until set_esdf_config).")
+      .def(
+          "set_esdf_config",
+          [](Tsdf& self, const EsdfConfig& c) {
+            const std::string why = c.validate(self.map.voxelSize());
+            if (!why.empty()) throw std::invalid_argument(why);
+            if (self.esdf) {
+              self.esdf->setConfig(c);
+            } else {  // not through esdfOf: the defaults may not suit this voxel size
+              self.esdf = std::make_unique<Esdf>(c, self.map.voxelSize());
+            }
+          },
+          py::arg("config"), "Raises ValueError if invalid; the next esdf_update is full.")
+      .def(
+          "esdf_update",
+          [](Tsdf& self) {
+            Esdf& esdf = esdfOf(self);
+            py::gil_scoped_release release;
+            return esdf.update(self.map);
+          },
+          "Brings the ESDF up to date with the map: recomputes only within max_distance_m of "
+          "voxels whose state (unknown / free / occupied) changed since the last update.")
+      .def(
+          "esdf_recompute",
+          [](Tsdf& self) {
+            Esdf& esdf = esdfOf(self);
+            py::gil_scoped_release release;
+            return esdf.recompute(self.map);
+          },
+          "Recomputes the whole ESDF.")
+      .def(
+          "esdf_distance",
+          [](Tsdf& self, const PointRows& points) {
+            const Esdf& esdf = esdfOf(self);
+            const auto n = static_cast<py::ssize_t>(points.rows());
+            py::array_t<double> distance(n);
+            py::array_t<double> gradient({n, py::ssize_t{3}});
+            auto d = distance.mutable_unchecked<1>();
+            auto g = gradient.mutable_unchecked<2>();
+            {
+              py::gil_scoped_release release;
+              for (py::ssize_t i = 0; i < n; ++i) {
+                const EsdfSample s = esdf.sample(points.row(i).transpose());
+                d(i) = s.distance;
+                for (int a = 0; a < 3; ++a) g(i, a) = s.gradient(a);
+              }
+            }
+            return py::make_tuple(distance, gradient);
+          },
+          py::arg("points"),
+          "Signed distance (N,) in m and its gradient (N, 3) at points (N, 3), trilinear "
+          "between the 8 voxel centres around each point; NaN where one of them is unknown. "
+          "As of the last esdf_update.")
+      .def(
+          "esdf_voxels", [](Tsdf& self) { return knownVoxels(esdfOf(self)); },
+          "Every known ESDF voxel: dict of voxels (N, 3) int32 lattice indices (centre = index "
+          "* voxel_size_m), distance (N,) float32 m, occupied (N,) int8.")
+      .def_property_readonly("esdf_block_count",
+                             [](Tsdf& self) { return esdfOf(self).blockCount(); })
+      .def_property_readonly(
+          "esdf_memory_bytes", [](Tsdf& self) { return esdfOf(self).memoryBytes(); },
+          "Bytes held by the ESDF's blocks, hash table and scratch.");
+}

@@ -1,0 +1,124 @@
+"""pytest: the ESDF through Python, against scipy's exact Euclidean distance transform on the
+simulated room, incrementally (a box taken away), and its interpolated distance and gradient."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+dp = pytest.importorskip("downstream_perception._core", reason="compiled core not built")
+ndimage = pytest.importorskip("scipy.ndimage")
+
+from downstream_perception.sim.depth_camera import (  # noqa: E402
+    DepthCamera,
+    Scene3D,
+    circle_poses,
+    room_scene,
+)
+
+VOXEL = 0.05
+MAX_DISTANCE = 0.6
+
+
+def make_tsdf() -> dp.Tsdf:
+    config = dp.TsdfConfig()
+    config.voxel_size_m = VOXEL
+    config.carve_free_space = True
+    tsdf = dp.Tsdf(config)
+    esdf = dp.EsdfConfig()
+    esdf.max_distance_m = MAX_DISTANCE
+    tsdf.set_esdf_config(esdf)
+    return tsdf
+
+
+def integrate(tsdf: dp.Tsdf, scene: Scene3D, poses: list[np.ndarray]) -> list[dp.EsdfUpdateStats]:
+    cam = DepthCamera()
+    pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
+    stats = []
+    for pose in poses:
+        tsdf.integrate_depth(cam.render(scene, pose), pinhole, pose)
+        stats.append(tsdf.esdf_update())
+    return stats
+
+
+def oracle_mismatches(tsdf: dp.Tsdf) -> tuple[int, int]:
+    """(voxels whose ESDF value differs from scipy's exact EDT of the TSDF's states, voxels
+    known) over the known voxels' bounding box plus a block."""
+    known = tsdf.esdf_voxels()
+    lo = known["voxels"].min(axis=0) - 8
+    hi = known["voxels"].max(axis=0) + 8
+    shape = tuple(hi - lo + 1)
+    idx = np.stack(
+        np.meshgrid(*[np.arange(a, b + 1) for a, b in zip(lo, hi, strict=True)], indexing="ij"), -1
+    )
+    sdf, _ = tsdf.sample(idx.reshape(-1, 3) * VOXEL)
+    sdf = sdf.reshape(shape)
+    free = sdf >= 0.0  # NaN (unknown) is neither
+    occupied = sdf < 0.0
+    # Distance from each voxel to the nearest voxel of the other state (lattice units).
+    to_occupied = ndimage.distance_transform_edt(~occupied)
+    to_free = ndimage.distance_transform_edt(~free)
+    expected = np.full(shape, np.nan, dtype=np.float32)
+    expected[free] = np.minimum(MAX_DISTANCE, (to_occupied[free] - 0.5) * VOXEL)
+    expected[occupied] = -np.minimum(MAX_DISTANCE, (to_free[occupied] - 0.5) * VOXEL)
+    got = np.full(shape, np.nan, dtype=np.float32)
+    v = known["voxels"] - lo
+    got[v[:, 0], v[:, 1], v[:, 2]] = known["distance"]
+    differ = ~((got == expected) | (np.isnan(got) & np.isnan(expected)))
+    return int(differ.sum()), int((free | occupied).sum())
+
+
+def test_incremental_esdf_matches_scipy_exact_edt_with_a_box_taken_away() -> None:
+    tsdf = make_tsdf()
+    poses = circle_poses(8)
+    scene = room_scene()
+    stats = integrate(tsdf, scene, poses)
+    assert stats[0].full and not any(s.full for s in stats[1:])
+    off, known = oracle_mismatches(tsdf)
+    assert off == 0
+    assert known > 100_000
+    without_box = room_scene()
+    without_box.boxes = without_box.boxes[1:]  # the table top stays
+    stats = integrate(tsdf, without_box, poses)
+    assert sum(s.voxels_changed for s in stats) > 1000
+    assert oracle_mismatches(tsdf)[0] == 0
+    # The incremental field is the one a full recomputation gives, voxel for voxel.
+    incremental = tsdf.esdf_voxels()
+    assert tsdf.esdf_recompute().full
+    full = tsdf.esdf_voxels()
+    order_i = np.lexsort(incremental["voxels"].T)
+    order_f = np.lexsort(full["voxels"].T)
+    np.testing.assert_array_equal(incremental["voxels"][order_i], full["voxels"][order_f])
+    np.testing.assert_array_equal(incremental["distance"][order_i], full["distance"][order_f])
+    # The box's centre was inside it; now it is free space.
+    d, _ = tsdf.esdf_distance(np.array([[0.8073, 0.5959, 0.3529]]))
+    assert d[0] > 0.0
+    assert tsdf.esdf_block_count <= tsdf.block_count
+    assert 0 < tsdf.esdf_memory_bytes
+
+
+def test_floor_distance_and_gradient_in_a_numpy_batch() -> None:
+    # The room's floor lies 2.9 mm above the voxel layer k = 0, so layers k <= 0 are occupied
+    # and a free voxel k is k layers above the nearest occupied one: (k - 1/2) * 5 cm. Away from
+    # everything else (0.5 m from the box, 1 m from the pole) the interpolated field is
+    # d = z - 0.025 m with gradient (0, 0, 1).
+    tsdf = make_tsdf()
+    integrate(tsdf, room_scene(), circle_poses(8))
+    points = np.array([[0.0, 0.3, 0.2], [0.013, 0.27, 0.131], [-0.11, 0.2, 0.0625]])
+    d, grad = tsdf.esdf_distance(points)
+    assert d.shape == (3,) and grad.shape == (3, 3)
+    np.testing.assert_allclose(d, points[:, 2] - 0.025, atol=1e-6)
+    np.testing.assert_allclose(grad, np.tile([0.0, 0.0, 1.0], (3, 1)), atol=1e-5)
+    # Outside the map: unknown.
+    d, grad = tsdf.esdf_distance(np.array([[50.0, 0.0, 1.0], [np.nan, 0.0, 0.0]]))
+    assert np.isnan(d).all() and np.isnan(grad).all()
+
+
+def test_esdf_config_is_checked_against_the_voxel_size() -> None:
+    tsdf = make_tsdf()
+    bad = dp.EsdfConfig()
+    bad.max_distance_m = 0.01  # below one 5 cm voxel
+    assert bad.validate(VOXEL) != ""
+    with pytest.raises(ValueError, match="max_distance_m"):
+        tsdf.set_esdf_config(bad)
+    assert tsdf.esdf_config.max_distance_m == MAX_DISTANCE

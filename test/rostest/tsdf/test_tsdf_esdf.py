@@ -1,0 +1,83 @@
+#!/usr/bin/env python3
+"""rostest: the TSDF nodelet's ESDF on 12 simulated depth frames of the analytic room.
+
+The room's floor lies 2.9 mm above the voxel layer z = 0, so that layer (and those below it)
+is occupied and a free voxel k layers up is k layers from the nearest occupied one: its ESDF
+value is (k - 1/2) * 5 cm, and between voxel centres away from other objects the interpolated
+field is d = z - 0.025 m with gradient (0, 0, 1). ~esdf_slice holds the voxel layer at 1 m,
+with the same values the service gives at those voxel centres.
+"""
+
+from __future__ import annotations
+
+import time
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from geometry_msgs.msg import Point
+from sensor_msgs import point_cloud2
+from sensor_msgs.msg import PointCloud2
+from std_msgs.msg import Bool
+
+from downstream_perception.ros.util import wait_until
+from downstream_perception.srv import EsdfDistance
+
+MAX_DISTANCE = 0.8
+
+
+class TsdfEsdfTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node("test_tsdf_esdf")
+        cls.done = False
+        cls.slice: PointCloud2 | None = None
+
+        def on_done(msg: Bool) -> None:
+            cls.done = cls.done or msg.data
+
+        def on_slice(msg: PointCloud2) -> None:
+            cls.slice = msg
+
+        rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
+        rospy.Subscriber("/tsdf/esdf_slice", PointCloud2, on_slice, queue_size=1)
+        rospy.wait_for_service("/tsdf/esdf_distance", 20.0)
+        cls.query = rospy.ServiceProxy("/tsdf/esdf_distance", EsdfDistance)
+
+    def distances(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        reply = self.query([Point(*p) for p in points])
+        gradients = np.array([[g.x, g.y, g.z] for g in reply.gradients]).reshape(-1, 3)
+        return np.array(reply.distances), gradients, np.array(reply.observed, dtype=bool)
+
+    def test_1_floor_distance_and_gradient(self) -> None:
+        self.assertTrue(wait_until(lambda: self.done, 40.0), "the simulator did not finish")
+        points = np.array([[0.0, 0.3, 0.1], [0.013, 0.27, 0.131], [-0.11, 0.2, 0.0625]])
+        d, grad, observed = self.distances(points)
+        self.assertTrue(observed.all())
+        np.testing.assert_allclose(d, points[:, 2] - 0.025, atol=1e-6)
+        np.testing.assert_allclose(grad, np.tile([0.0, 0.0, 1.0], (3, 1)), atol=1e-5)
+        d, grad, observed = self.distances(np.array([[50.0, 0.0, 1.0]]))
+        self.assertFalse(observed[0])
+        self.assertTrue(np.isnan(d[0]) and np.isnan(grad).all())
+
+    def test_2_slice_agrees_with_the_service(self) -> None:
+        self.assertTrue(wait_until(lambda: self.done, 40.0), "the simulator did not finish")
+        time.sleep(1.5)  # a mesh tick (2 Hz) after the last frame
+        self.assertTrue(wait_until(lambda: self.slice is not None, 10.0), "no ~esdf_slice")
+        cloud = np.array(
+            list(point_cloud2.read_points(self.slice, ("x", "y", "z", "distance"))), dtype=float
+        )
+        self.assertGreater(len(cloud), 2000)
+        np.testing.assert_allclose(cloud[:, 2], 1.0, atol=1e-6)
+        self.assertTrue((np.abs(cloud[:, 3]) <= MAX_DISTANCE + 1e-6).all())
+        self.assertTrue((cloud[:, 3] < 0).any())  # behind the walls
+        self.assertTrue((cloud[:, 3] > 0.3).any())  # open space
+        sample = cloud[:: max(1, len(cloud) // 300)]
+        d, _, observed = self.distances(sample[:, :3])
+        self.assertGreater(int(observed.sum()), len(sample) // 2)
+        np.testing.assert_allclose(d[observed], sample[observed, 3], atol=1e-6)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("downstream_perception", "test_tsdf_esdf", TsdfEsdfTest)
