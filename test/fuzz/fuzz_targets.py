@@ -887,14 +887,33 @@ def garbage_mask_iou(a: dict[str, Any], r: Any) -> str | None:
 # ----------------------------------------------------------------------------- seam health
 def gen_expected_smear(rng: np.random.Generator) -> dict[str, Any]:
     g = Gen(rng, 0.35)
-    return {"range_m": g.f(0, 30), "yaw_rate_rps": g.f(-3, 3), "age_s": g.f(0, 0.3)}
+    limits = {
+        name: g.f(lo, hi, 0.15)
+        for name, lo, hi in (
+            ("reference_range_m", 0, 30), ("max_transform_age_s", 0, 1),
+            ("max_smear_m", 0, 1), ("max_map_odom_age_s", 0, 10),
+        )
+    }  # fmt: skip
+    return {
+        "range_m": g.f(0, 30), "yaw_rate_rps": g.f(-3, 3), "age_s": g.f(0, 0.3), "limits": limits,
+    }  # fmt: skip
 
 
 def call_expected_smear(a: dict[str, Any]) -> Any:
-    return core().expected_smear(a["range_m"], a["yaw_rate_rps"], a["age_s"])
+    c = core()
+    # SeamLimits is a plain holder of the handoff's warning limits: whatever is stored (NaN,
+    # Inf, negative) must read back unchanged; the nodelet validates them (acceptValid).
+    limits = configure(c.SeamLimits(), a["limits"])
+    read_back = {name: getattr(limits, name) for name in a["limits"]}
+    return c.expected_smear(a["range_m"], a["yaw_rate_rps"], a["age_s"]), read_back
 
 
-def garbage_expected_smear(a: dict[str, Any], r: Any) -> str | None:
+def garbage_expected_smear(a: dict[str, Any], result: Any) -> str | None:
+    r, read_back = result
+    for name, value in a["limits"].items():
+        stored = read_back[name]
+        if not (stored == value or (math.isnan(stored) and math.isnan(value))):
+            return f"SeamLimits.{name} stored {value}, read back {stored}"
     rng_m, rate, age = a["range_m"], a["yaw_rate_rps"], a["age_s"]
     if moderate(rng_m, rate, age) and abs(rate * age) < 1.5 and rng_m >= 0 and age >= 0:
         if not (math.isfinite(r) and r >= 0):
@@ -1910,7 +1929,7 @@ def binding_targets() -> list[Target]:
             gen_expected_smear,
             call_expected_smear,
             garbage_expected_smear,
-            ("expected_smear",),
+            ("expected_smear", "SeamLimits"),
         ),
         Target(
             "CorrectionMonitor",
