@@ -120,6 +120,45 @@ def test_the_report_plots_processing_times(replayed: Path) -> None:
     assert re.search(r"update time p50 \(ms\): [0-9.e+-]+", report), report
 
 
+def test_the_report_judges_the_seam(replayed: Path) -> None:
+    png = replayed / "seam_health.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    report = (replayed / "report.md").read_text()
+    assert "## Seam health" in report
+    # The aisle bag's scans carry the stamp of a /tf message: age 0, no smear; its map <- odom
+    # is the constant (0.5, -0.2) m, |correction| 0.539 m.
+    m = re.search(
+        r"`/scan`: p95 transform age ([0-9.]+) ms, p95 expected smear at 5 m ([0-9.]+)", report
+    )
+    assert m is not None, report
+    assert float(m.group(1)) <= 1.0 and float(m.group(2)) == 0.0
+    assert "|correction| 0.539-0.539 m" in report, report
+
+
+def test_seam_figures_follow_the_lesson() -> None:
+    from downstream_perception.replay import seam
+
+    # A robot turning at 90 deg/s; one scan 30 ms newer than the newest transform, one older.
+    t = np.linspace(0.0, 2.0, 201)
+    motion = seam.RobotMotion(t, np.c_[t, np.zeros_like(t)], np.pi / 2 * t)
+    assert motion.yaw_rate_rps() == pytest.approx(np.full(len(t), np.pi / 2))
+    assert motion.travelled_m()[-1] == pytest.approx(2.0)
+    limits = dp.SeamLimits()
+    inputs = seam.input_seams({"/scan": [0.5, 1.0]}, {"/scan": [0.030, -0.010]}, motion, limits)
+    # The lesson's 5 m * tan(90 deg/s * 30 ms) = 0.236 m; a negative age throws nothing.
+    assert inputs["/scan"].smear_m == pytest.approx([0.2358, 0.0], abs=1e-4)
+    report = seam.SeamReport(limits, inputs, np.zeros(0), np.zeros(0), [])
+    lines = "\n".join(report.lines())
+    assert "WARN: age above" not in lines  # p95 of (30, -10) ms = 28 ms < 100 ms
+    assert "WARN: smear above 0.050 m" in lines
+    assert "map <- odom: not in the bag" in lines
+    # A correction that ramps 1 m over 100 s of travel without a reset: never resets.
+    ct = np.linspace(0.0, 100.0, 101)
+    findings = seam.correction_findings(ct, ct / 100.0, ct)
+    assert any("reset" in f for f in findings), findings
+    assert seam.correction_findings(ct, np.full(len(ct), 0.3), ct) == []
+
+
 def test_processing_histograms_read_the_nodelets_encoding() -> None:
     from downstream_perception.replay import outputs
 

@@ -25,6 +25,7 @@ class BagSummary:
     tf_parents: dict[str, str] = field(default_factory=dict)  # child -> parent, /tf and /tf_static
     clock_jumps: list[str] = field(default_factory=list)
     transform_ages_s: dict[str, list[float]] = field(default_factory=dict)
+    input_stamps_s: dict[str, list[float]] = field(default_factory=dict)  # parallel to the ages
 
     @property
     def duration_s(self) -> float:
@@ -78,9 +79,9 @@ def summarize(bag: Any, path: Path, input_topics: list[str]) -> BagSummary:
             elif hasattr(msg, "header"):
                 summary.frames.setdefault(topic, msg.header.frame_id.lstrip("/"))
                 if math.isfinite(newest_tf_s):
-                    summary.transform_ages_s.setdefault(topic, []).append(
-                        msg.header.stamp.to_sec() - newest_tf_s
-                    )
+                    stamp_s = msg.header.stamp.to_sec()
+                    summary.transform_ages_s.setdefault(topic, []).append(stamp_s - newest_tf_s)
+                    summary.input_stamps_s.setdefault(topic, []).append(stamp_s)
     except Exception as e:  # noqa: BLE001 - rosbag raises several types for damaged chunks
         raise ReplayError(f"{path}: reading the bag failed: {type(e).__name__}: {e}") from e
     return summary

@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from downstream_perception.replay import outputs
+from downstream_perception.replay import outputs, seam
 from downstream_perception.replay.bag import BagSummary
 from downstream_perception.replay.pipeline import (
     Pipeline,
@@ -22,7 +22,8 @@ from downstream_perception.replay.run import ReplayOptions, ReplayResult, replay
 OUTPUTS = [
     Path(name)
     for name in ("costmap.pgm", "costmap.yaml", "tracks.csv", "mesh.ply", "octomap.bt", "map.png",
-                 "transform_ages.png", "processing_times.png", "report.md", "report.html")
+                 "transform_ages.png", "processing_times.png", "seam_health.png", "report.md",
+                 "report.html")
 ]  # fmt: skip
 
 DESCRIPTION = """Replay a recorded bag through the same nodelets and YAML as on the robot, and
@@ -33,7 +34,10 @@ ROS master on simulated time taken from the bag: /use_sim_time, and the bag's /t
 and the configured input topics published in record order with /clock at each one's record
 time, at --rate times real time. Writes to --out: the final costmap as a map_server map
 (costmap.pgm + costmap.yaml, which the StaticLayer loads) and a PNG with the robot's path; the
-tracks as tracks.csv; the TSDF's mesh.ply and octomap.bt; and report.md / report.html.
+tracks as tracks.csv; the TSDF's mesh.ply and octomap.bt; plots of the transform ages, the
+processing times and the seam health (each input message's expected smear at the handoff's
+reference range from the robot's yaw rate and the message's transform age; |map <- odom| with
+the handoff's CorrectionMonitor findings); and report.md / report.html.
 
 A bag that cannot be replayed (unreadable or not indexed, none of a capability's topics, a topic
 of the wrong type, no tf joining the data to the frame it is needed in, a clock that jumps back)
@@ -99,6 +103,10 @@ def write_outputs(out: Path, pipeline: Pipeline, summary: BagSummary, result: Re
     ages = outputs.render_histograms(summary.transform_ages_s, out / "transform_ages.png")
     if ages is not None:
         images.append(("Transform ages", ages))
+    if result.seam is not None:
+        health = seam.render_seam_health(result.seam, summary.start_s, out / "seam_health.png")
+        if health is not None:
+            images.append(("Seam health: expected smear per message, map <- odom", health))
     histograms = outputs.processing_histograms(result.diagnostics)
     times = outputs.render_processing_times(histograms, out / "processing_times.png")
     if times is not None:
@@ -156,6 +164,8 @@ def report_lines(
     }
     lines += ["", "## Processing (diagnostics: counts, means, maxima and percentiles)", ""]
     lines += [f"- {k}: {v}" for k, v in sorted(timing.items())] or ["- none reported"]
+    if result.seam is not None:
+        lines += result.seam.lines()
     lines += ["", "## Files", ""] + [f"- {k}: `{p.name}`" for k, p in files.items()]
     return lines
 

@@ -17,6 +17,8 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+import downstream_perception as dp
+from downstream_perception.replay import seam
 from downstream_perception.replay.bag import TF_TOPICS, BagSummary, check, open_bag, summarize
 from downstream_perception.replay.outputs import TrackLog
 from downstream_perception.replay.pipeline import Pipeline, ReplayError
@@ -57,12 +59,11 @@ class ReplayResult:
     tracks: TrackLog | None = None  # tracks.csv, written while the bag plays
     saved: dict[str, str] = field(default_factory=dict)  # what the TSDF nodelet wrote, or why not
     path_xy: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    seam: seam.SeamReport | None = None
 
 
-def robot_path(
-    bag: Any, target: str, robot: str, summary: BagSummary, samples: int = 400
-) -> np.ndarray:
-    """target <- robot at evenly spaced times, from the bag's own tf."""
+def bag_tf(bag: Any, summary: BagSummary) -> Any:
+    """A tf2 buffer holding the bag's whole /tf and /tf_static."""
     import rospy
     import tf2_ros
 
@@ -78,14 +79,43 @@ def robot_path(
                     buffer.set_transform_static(tf, "bag")
                 else:
                     buffer.set_transform(tf, "bag")
-    points = []
+    return buffer
+
+
+def sampled_transforms(
+    buffer: Any, target: str, source: str, summary: BagSummary, samples: int = 400
+) -> tuple[np.ndarray, np.ndarray]:
+    """target <- source at evenly spaced bag times: (times s, rows x y yaw) where tf has it."""
+    import rospy
+    import tf2_ros
+
+    times, poses = [], []
     for t in np.linspace(summary.start_s, summary.end_s, samples):
         try:
-            tf = buffer.lookup_transform(target, robot, rospy.Time.from_sec(t))
+            tf = buffer.lookup_transform(target, source, rospy.Time.from_sec(t))
         except tf2_ros.TransformException:
             continue
-        points.append((tf.transform.translation.x, tf.transform.translation.y))
-    return np.array(points).reshape(-1, 2)
+        q, p = tf.transform.rotation, tf.transform.translation
+        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        times.append(t)
+        poses.append((p.x, p.y, yaw))
+    return np.array(times), np.array(poses).reshape(-1, 3)
+
+
+def seam_report(buffer: Any, summary: BagSummary, target: str, robot: str) -> tuple[Any, Any]:
+    """The robot's motion (for the map and the smear) and the seam health of the bag."""
+    t, poses = sampled_transforms(buffer, target, robot, summary)
+    motion = seam.RobotMotion(t, poses[:, :2], poses[:, 2])
+    limits = dp.SeamLimits()
+    inputs = seam.input_seams(summary.input_stamps_s, summary.transform_ages_s, motion, limits)
+    # REP-105's names: the localisation correction is map <- odom.
+    ct, corrections = np.zeros(0), np.zeros(0)
+    if summary.tf_parents.get("odom") == "map":
+        ct, c = sampled_transforms(buffer, "map", "odom", summary)
+        corrections = np.linalg.norm(c[:, :2], axis=1)
+    travelled = np.interp(ct, motion.t_s, motion.travelled_m()) if len(t) else np.zeros(len(ct))
+    findings = seam.correction_findings(ct, corrections, travelled)
+    return motion, seam.SeamReport(limits, inputs, ct, corrections, findings)
 
 
 def launch_file(pipeline: Pipeline, out: Path) -> str:
@@ -119,7 +149,9 @@ def replay(
         if problems:
             raise ReplayError("; ".join(problems))
         first = pipeline.capabilities[0]
-        path_xy = robot_path(bag, first.frame, pipeline.robot_frame, summary)
+        motion, seam_health = seam_report(
+            bag_tf(bag, summary), summary, first.frame, pipeline.robot_frame
+        )
         out.mkdir(parents=True, exist_ok=True)
         port = free_port()
         os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
@@ -131,7 +163,7 @@ def replay(
                 run = NodeletRun(bag, summary, pipeline, out, options)
                 run.start(launch, port, procs, log)
                 result = run.play()
-                result.path_xy = path_xy
+                result.path_xy, result.seam = motion.xy, seam_health
                 return summary, result
             finally:
                 for proc in reversed(procs):
