@@ -159,6 +159,20 @@ def test_seam_figures_follow_the_lesson() -> None:
     assert seam.correction_findings(ct, np.full(len(ct), 0.3), ct) == []
 
 
+def test_tf_rejections_are_counted_for_the_rate_warning() -> None:
+    from downstream_perception.replay import cli
+
+    diagnostics = {
+        "/costmap: layer obstacles: scan: rejected (tf: older than the transform cache)": "489",
+        "/costmap: layer obstacles: scan: rejected (tf: lookup at stamp failed)": "18",
+        "/costmap: layer obstacles: scan: rejected (malformed)": "4",
+        "/costmap: layer obstacles: scan: messages rejected": "511",
+    }
+    assert cli.tf_rejections(diagnostics) == 507
+    assert "507 messages" in cli.behind_warning(507) and "--rate" in cli.behind_warning(507)
+    assert cli.tf_rejections({"x: messages rejected": "3"}) == 0
+
+
 def test_processing_histograms_read_the_nodelets_encoding() -> None:
     from downstream_perception.replay import outputs
 
