@@ -9,8 +9,9 @@ cd "$WS"
 if [[ -f build/CMakeCache.txt ]] && ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" build/CMakeCache.txt; then
   rm -rf build devel  # a cache configured with another python (pitfall P14)
 fi
+# shellcheck disable=SC2046 # one argument or none
 if ! catkin_make -j2 -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON \
-    -DPYTHON_EXECUTABLE=/usr/bin/python3 "$@" > "$WS/build.log" 2>&1; then
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 $(pybind11_cmake_args) "$@" > "$WS/build.log" 2>&1; then
   grep -E 'error|Error' "$WS/build.log" | head -40 || true
   tail -40 "$WS/build.log"
   echo "build: catkin_make failed (full log: $WS/build.log)" >&2

@@ -40,3 +40,11 @@ link_package() {
     ln -sfn "$entry" "$dest/$name"
   done
 }
+pybind11_cmake_args() {
+  # -Dpybind11_DIR=<PyPI pybind11's CMake dir> when tools/python_venv.sh installed it (numpy 1
+  # and 2); nothing (Debian's pybind11 2.10, numpy 1 only) when it could not.
+  local dir
+  if dir="$("$WS/build-venv/bin/python" -m pybind11 --cmakedir 2> /dev/null)"; then
+    echo "-Dpybind11_DIR=$dir"
+  fi
+}

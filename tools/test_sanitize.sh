@@ -20,8 +20,9 @@ fi
 # gencfg gives the pytests the dynamic_reconfigure Python modules.
 # RelWithDebInfo at -O1: readable reports, and pybind11 adds no LTO in that configuration.
 start=$SECONDS
+# shellcheck disable=SC2046 # pybind11_cmake_args: one argument or none
 if ! catkin_make -j2 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=ON \
-  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF \
+  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF $(pybind11_cmake_args) \
   "-DCMAKE_CXX_FLAGS=$SAN_FLAGS" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
   "-DCMAKE_EXE_LINKER_FLAGS=$SAN_FLAGS" "-DCMAKE_SHARED_LINKER_FLAGS=$SAN_FLAGS" \
   "-DCMAKE_MODULE_LINKER_FLAGS=$SAN_FLAGS" \

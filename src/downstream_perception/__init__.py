@@ -29,7 +29,8 @@ def numpy_abi_problem(numpy_version: str, pybind11_version: tuple[int, int]) -> 
 
     pybind11 before 2.12 reads numpy's array descriptors with numpy 1's layout; under numpy 2
     its arrays come out silently wrong (every row a copy of the first), so refuse instead.
-    Debian 12 ships pybind11 2.10 and numpy 1.24: run with Debian's python3.
+    The build (tools/python_venv.sh) uses pybind11 2.13 from PyPI, which works with numpy 1 and
+    2; the refusal only fires for a build that fell back to Debian 12's pybind11 2.10.
     """
     if int(numpy_version.split(".")[0]) >= 2 and tuple(pybind11_version) < (2, 12):
         return (
