@@ -69,16 +69,30 @@ double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// FNV-1a over a grid's bytes: equal checksums in a row show bit-identical grids.
+template <class T>
+std::uint64_t checksumOf(const T* data, std::size_t n) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(data);
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::size_t i = 0; i < n * sizeof(T); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+  return h;
+}
+
 // One obstacle-layer update as the costmap runs it: integrate the scan, then write the states of
 // the cells whose state changed into the master (what the layer reports as its bounds). Also
 // timed: the write over the whole window the scan touched (costmap_2d merges that window every
-// update) and the first scan into an empty (all-unknown) grid.
+// update) and the first scan into an empty (all-unknown) grid. Each update runs twice, in turn,
+// on two grids fed the same scans: with the automatic clearing walk (what the layer runs: the
+// block skip for dense scans) and with the per-ray walk (the reference, as before issue 20), so
+// both are timed in the same rounds; the grids' checksums show they stay bit-identical.
 void runIntegration(int size, double room_half, int beams, int iters) {
   const GridGeometry geometry(size, size, 0.05, -size * 0.025, -size * 0.025);
   ScanIntegratorConfig config;
   config.obstacle_max_range = 30.0;
   config.raytrace_max_range = 30.0;
   ScanIntegrator integrator(config);
+  ScanIntegrator per_ray(config);
+  per_ray.setClearingWalk(ClearingWalk::kPerRay);
   std::mt19937 rng(1);
   std::vector<std::vector<float>> scans;
   for (int i = 0; i < 16; ++i) scans.push_back(roomScan(beams, room_half, 0.01, rng));
@@ -88,46 +102,71 @@ void runIntegration(int size, double room_half, int beams, int iters) {
     return LaserScanView{r.data(), r.size(), -M_PI, 2.0 * M_PI / beams, 0.05, 30.0};
   };
 
-  std::vector<double> first;
+  std::vector<double> first, first_per_ray;
   for (int i = 0; i < 5; ++i) {
-    LogOddsGrid fresh(geometry);
-    const auto t0 = std::chrono::steady_clock::now();
-    integrator.integrate(fresh, view(i), pose);
-    first.push_back(msSince(t0));
+    for (ScanIntegrator* it : {&integrator, &per_ray}) {
+      LogOddsGrid fresh(geometry);
+      const auto t0 = std::chrono::steady_clock::now();
+      it->integrate(fresh, view(i), pose);
+      (it == &integrator ? first : first_per_ray).push_back(msSince(t0));
+    }
   }
 
-  LogOddsGrid grid(geometry);
-  Costmap master(geometry, cost::kNoInformation);
-  std::vector<double> integrate_ms, layer_ms, touched_write_ms;
+  struct Side {
+    ScanIntegrator* integrator;
+    LogOddsGrid grid;
+    Costmap master;
+    std::vector<double> integrate_ms, layer_ms;
+  };
+  Side sides[2] = {
+      {&integrator, LogOddsGrid(geometry), Costmap(geometry, cost::kNoInformation), {}, {}},
+      {&per_ray, LogOddsGrid(geometry), Costmap(geometry, cost::kNoInformation), {}, {}}};
+  std::vector<double> touched_write_ms;
+  Costmap touched_master(geometry, cost::kNoInformation);
   std::size_t cells = 0;
   std::size_t changed = 0;
   for (int i = 0; i < iters + 20; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const IntegrationStats s = integrator.integrate(grid, view(i), pose);
-    const double t_integrate = msSince(t0);
-    writeStateCosts(grid, s.changed, false, cost::kNoInformation, &master);
-    const double t_layer = msSince(t0);
-    const auto t1 = std::chrono::steady_clock::now();
-    writeStateCosts(grid, s.touched, false, cost::kNoInformation, &master);
-    const double t_touched = msSince(t1);
-    if (i >= 20) {  // warm-up (the grid converging to steady state) excluded
-      integrate_ms.push_back(t_integrate);
-      layer_ms.push_back(t_layer);
-      touched_write_ms.push_back(t_touched);
+    for (int k = 0; k < 2; ++k) {
+      Side& side = sides[(i + k) % 2];  // alternate which walk goes first
+      const auto t0 = std::chrono::steady_clock::now();
+      const IntegrationStats s = side.integrator->integrate(side.grid, view(i), pose);
+      const double t_integrate = msSince(t0);
+      writeStateCosts(side.grid, s.changed, false, cost::kNoInformation, &side.master);
+      const double t_layer = msSince(t0);
+      if (i < 20) continue;  // warm-up (the grid converging to steady state) excluded
+      side.integrate_ms.push_back(t_integrate);
+      side.layer_ms.push_back(t_layer);
+      if (&side != &sides[0]) continue;
+      const auto t1 = std::chrono::steady_clock::now();
+      writeStateCosts(side.grid, s.touched, false, cost::kNoInformation, &touched_master);
+      touched_write_ms.push_back(msSince(t1));
       cells += s.cells_cleared + s.cells_marked;
       changed += s.cells_changed;
     }
   }
-  const double median = medianOf(integrate_ms);
+  const double median = medianOf(sides[0].integrate_ms);
   const double cells_per_scan = static_cast<double>(cells) / iters;
+  const std::size_t n = geometry.cellCount();
+  const std::uint64_t sum = checksumOf(sides[0].grid.rawCells(), n);
+  const std::uint64_t sum_per_ray = checksumOf(sides[1].grid.rawCells(), n);
+  const std::uint64_t master_sum = checksumOf(sides[0].master.cells().data(), n);
+  const std::uint64_t master_sum_per_ray = checksumOf(sides[1].master.cells().data(), n);
   std::printf(
       "{\"bench\": \"scan_integration\", \"map\": %d, \"room_half_m\": %.3f, \"beams\": %d, "
       "\"iters\": %d, \"median_ms\": %.4f, \"p90_ms\": %.4f, \"layer_update_ms\": %.4f, "
-      "\"touched_window_write_ms\": %.4f, \"first_scan_ms\": %.4f, \"cells_per_scan\": %.0f, "
-      "\"cells_changed_per_scan\": %.1f, \"mcells_per_s\": %.1f}\n",
-      size, room_half, beams, iters, median, p90Of(integrate_ms), medianOf(layer_ms),
-      medianOf(touched_write_ms), medianOf(first), cells_per_scan,
-      static_cast<double>(changed) / iters, cells_per_scan / (median * 1e-3) / 1e6);
+      "\"per_ray_median_ms\": %.4f, \"per_ray_layer_update_ms\": %.4f, "
+      "\"touched_window_write_ms\": %.4f, \"first_scan_ms\": %.4f, "
+      "\"per_ray_first_scan_ms\": %.4f, \"cells_per_scan\": %.0f, "
+      "\"cells_changed_per_scan\": %.1f, \"mcells_per_s\": %.1f, \"grid_checksum\": \"%016llx\", "
+      "\"per_ray_grid_checksum\": \"%016llx\", \"master_checksum\": \"%016llx\", "
+      "\"per_ray_master_checksum\": \"%016llx\"}\n",
+      size, room_half, beams, iters, median, p90Of(sides[0].integrate_ms),
+      medianOf(sides[0].layer_ms), medianOf(sides[1].integrate_ms), medianOf(sides[1].layer_ms),
+      medianOf(touched_write_ms), medianOf(first), medianOf(first_per_ray), cells_per_scan,
+      static_cast<double>(changed) / iters, cells_per_scan / (median * 1e-3) / 1e6,
+      static_cast<unsigned long long>(sum), static_cast<unsigned long long>(sum_per_ray),
+      static_cast<unsigned long long>(master_sum),
+      static_cast<unsigned long long>(master_sum_per_ray));
 }
 
 // One whole costmap update as our costmap runs it on the anchor scenario (static map,

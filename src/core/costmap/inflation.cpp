@@ -1,6 +1,7 @@
 #include "downstream_perception/core/costmap/inflation.h"
 
 #include "downstream_perception/core/grid/grid_shift.h"
+#include "inflation_detail.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,26 +12,9 @@
 
 namespace downstream_perception {
 
-namespace {
-
-constexpr int kTileShift = 5;  // 32 x 32 cell tiles mark where lethal cells changed
-
-CellBounds grow(const CellBounds& b, int by, const GridGeometry& g) {
-  CellBounds out;
-  out.min_x = std::max(0, b.min_x - by);
-  out.min_y = std::max(0, b.min_y - by);
-  out.max_x = std::min(g.sizeX() - 1, b.max_x + by);
-  out.max_y = std::min(g.sizeY() - 1, b.max_y + by);
-  return out;
-}
-
-std::size_t area(const CellBounds& b) {
-  return b.empty() ? 0
-                   : static_cast<std::size_t>(b.max_x - b.min_x + 1) *
-                         static_cast<std::size_t>(b.max_y - b.min_y + 1);
-}
-
-}  // namespace
+using inflation_detail::area;
+using inflation_detail::grow;
+using inflation_detail::kTileShift;
 
 std::string InflationConfig::validate() const {
   std::ostringstream why;
@@ -261,12 +245,17 @@ void Inflator::markDirty(const CellBounds& cells) {
 }
 
 void Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
+  recompute(region, g, &scratch_);
+}
+
+void Inflator::recompute(const CellBounds& region, const GridGeometry& g,
+                         std::vector<std::int32_t>* scratch) {
   if (region.empty()) return;
   const CellBounds sources = grow(region, radius_cells_, g);
-  boundedSquaredDistances(lethal_.data(), g.sizeX(), sources, region, radius_cells_, &scratch_);
+  boundedSquaredDistances(lethal_.data(), g.sizeX(), sources, region, radius_cells_, scratch);
   const int w = region.max_x - region.min_x + 1;
   for (int y = region.min_y; y <= region.max_y; ++y) {
-    const std::int32_t* d2 = scratch_.data() + static_cast<std::size_t>(y - region.min_y) * w;
+    const std::int32_t* d2 = scratch->data() + static_cast<std::size_t>(y - region.min_y) * w;
     std::uint8_t* c = costs_.data() + g.index(region.min_x, y);
     for (int x = 0; x < w; ++x) c[x] = costOfSquaredDistance(d2[x]);
   }
@@ -319,15 +308,7 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
   const CellBounds w = master->clamp(window);
 
   if (full_recompute_) {
-    for (std::size_t i = 0; i < g.cellCount(); ++i) {
-      lethal_[i] = m[i] == cost::kLethalObstacle ? 1 : 0;
-    }
-    CellBounds all;
-    all.expand(0, 0);
-    all.expand(g.sizeX() - 1, g.sizeY() - 1);
-    recompute(all, g);
-    stats.regions = 1;
-    stats.cells_recomputed = g.cellCount();
+    recomputeAll(m, g, &stats);
     std::fill(dirty_tiles_.begin(), dirty_tiles_.end(), 0);
     dirty_tile_count_ = 0;
     dirty_tile_box_ = CellBounds{};

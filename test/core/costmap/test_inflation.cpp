@@ -140,6 +140,64 @@ TEST(Inflator, FullUpdateMatchesTheExactOracleOnRandomMaps) {
   }
 }
 
+TEST(Inflator, BandRestrictedFullUpdateMatchesTheOracleOnOneAndTwoThreads) {
+  // Maps larger than a strip, with lethal cells in a few clusters (walls, a pillar, lone cells
+  // near the borders): the full update recomputes only the band around them, split over two
+  // threads, and must still equal the brute-force oracle everywhere.
+  std::mt19937 rng(11);
+  for (const auto& [sx, sy] : {std::pair<int, int>{300, 230}, {97, 410}, {33, 33}}) {
+    const GridGeometry g(sx, sy, 0.05, 0.3, -2.0);
+    for (const double radius : {0.05, 0.55, 1.6}) {
+      Costmap map(g, cost::kFreeSpace);
+      std::uniform_int_distribution<int> ux(0, sx - 1);
+      std::uniform_int_distribution<int> uy(0, sy - 1);
+      for (int k = 0; k < 4; ++k) {  // short walls
+        const int x0 = ux(rng);
+        const int y0 = uy(rng);
+        for (int i = 0; i < 25; ++i) {
+          const int x = k % 2 == 0 ? std::min(sx - 1, x0 + i) : x0;
+          const int y = k % 2 == 0 ? y0 : std::min(sy - 1, y0 + i);
+          map.setCost(x, y, cost::kLethalObstacle);
+        }
+      }
+      map.setCost(0, sy - 1, cost::kLethalObstacle);
+      map.setCost(sx - 1, 0, cost::kLethalObstacle);
+      InflationConfig c;
+      c.inflation_radius = radius;
+      c.cost_scaling_factor = 2.0;
+      c.inscribed_radius = 0.1;
+      const auto expected = oracle(map, c);
+      for (const int threads : {1, 2}) {
+        Costmap master = map;
+        Inflator inflator(c, g.resolution());
+        inflator.setThreads(threads);
+        const InflationStats stats = inflator.update(&master, everything(g));
+        for (std::size_t i = 0; i < g.cellCount(); ++i) {
+          ASSERT_EQ(inflator.costs()[i], expected[i])
+              << sx << "x" << sy << " radius " << radius << " threads " << threads << " cell " << i;
+        }
+        if (sx == 300 && radius < 1.0) {
+          // Sparse lethal cells on a large map: the band is a fraction of the map.
+          EXPECT_LT(stats.cells_recomputed, g.cellCount() * 3 / 4) << radius;
+          EXPECT_GE(stats.regions, 2u);
+        }
+      }
+    }
+  }
+}
+
+TEST(Inflator, FullUpdateOfAMapWithoutLethalCellsRecomputesNothing) {
+  const GridGeometry g(200, 150, 0.05, 0.0, 0.0);
+  Costmap map(g, cost::kFreeSpace);
+  InflationConfig c;
+  c.inflation_radius = 0.55;
+  Inflator inflator(c, g.resolution());
+  const InflationStats stats = inflator.update(&map, everything(g));
+  EXPECT_EQ(stats.cells_recomputed, 0u);
+  EXPECT_EQ(stats.regions, 0u);
+  for (const std::uint8_t v : inflator.costs()) ASSERT_EQ(v, 0);
+}
+
 TEST(Inflator, LethalCellsOnTheBorderAndRadiusZero) {
   const GridGeometry g(20, 10, 0.1, 0.0, 0.0);
   Costmap map(g, cost::kFreeSpace);

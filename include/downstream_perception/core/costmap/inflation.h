@@ -21,8 +21,10 @@
 // transform.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "downstream_perception/core/grid/costmap.h"
@@ -97,12 +99,27 @@ class Inflator {
   /// inflation radius around every place where lethal cells may have changed (updateBounds).
   InflationStats update(Costmap* master, const CellBounds& window);
 
+  /// Threads for a full recompute (1 or 2; default 2 where the machine has them): the band's
+  /// regions split between them, with the same costs bit for bit.
+  void setThreads(int threads) { threads_ = std::max(1, std::min(2, threads)); }
+  int threads() const { return threads_; }
+
   /// Cached inflation cost per cell (as if no cell were unknown), for tests and Python.
   const std::vector<std::uint8_t>& costs() const { return costs_; }
 
  private:
   void resizeTo(const GridGeometry& geometry);
   void recompute(const CellBounds& region, const GridGeometry& geometry);
+  void recompute(const CellBounds& region, const GridGeometry& geometry,
+                 std::vector<std::int32_t>* scratch);
+  /// The whole cache from the master: lethal cells, then the band within the radius of them
+  /// (src/core/costmap/inflation_band.cpp).
+  void recomputeAll(const std::uint8_t* master, const GridGeometry& geometry,
+                    InflationStats* stats);
+  /// The band's regions: runs of tiles within reach of a tile holding a lethal cell, per strip.
+  std::vector<CellBounds> bandRegions(const GridGeometry& geometry,
+                                      const std::vector<std::uint8_t>& lethal_tiles, int tiles_x,
+                                      int tiles_y) const;
   /// Marks the tiles covering `cells` (clamped) for recomputation at the next update.
   void markDirty(const CellBounds& cells);
   /// Recomputes every dirty tile's neighbourhood and clears the marks.
@@ -121,6 +138,7 @@ class Inflator {
   std::vector<CellBounds> pending_regions_;  ///< bands to recompute after a shift
   std::vector<std::int32_t> scratch_;
   bool full_recompute_ = true;
+  int threads_ = std::thread::hardware_concurrency() >= 2 ? 2 : 1;
 };
 
 }  // namespace downstream_perception

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/core/grid/ray_traversal.h"
 #include "downstream_perception/core/grid/se2.h"
 
 namespace downstream_perception {
@@ -71,10 +72,42 @@ struct IntegrationStats {
   void accumulate(const IntegrationStats& o);
 };
 
+/// How pass 2 walks the clearing rays (src/core/costmap/scan_clearing.cpp). Both give the same
+/// grid, statistics and flag order bit for bit; only the time differs.
+enum class ClearingWalk {
+  /// The block skip for dense scans (the rays' cells add up to more than the cells of the box
+  /// they touch), else the per-ray walk: what the integrator runs.
+  kAuto,
+  /// Every cell of every ray is visited (the reference the block walk is tested against).
+  kPerRay,
+  /// The grid is cut into 32 x 32 blocks; a block whose every cell is already flagged in this
+  /// scan or saturated free (so no ray of this scan can change it any more) is crossed in one
+  /// exact integer jump instead of cell by cell. Near the sensor, where the beams of a dense
+  /// scan overlap, most of every ray crosses such blocks.
+  kBlockSkip,
+};
+
+/// One clearing ray of a scan, set up before any is walked.
+struct ClearingRay {
+  RayWalk walk;
+  bool clear_end_cell = false;  ///< also clear the end cell (asked for, or the end was clipped)
+};
+
+/// Buffers integrateBeams reuses between scans (optional: without one it allocates per scan).
+struct IntegrationScratch {
+  std::vector<ClearingRay> rays;            ///< this scan's clearing rays
+  std::vector<std::uint32_t> flagged;       ///< cells flagged in this scan
+  std::vector<std::int32_t> block_pending;  ///< per block: -1 unchecked, else cells left to clear
+  std::vector<std::uint32_t> blocks_checked;
+  int blocks_x = 0;  ///< block_pending's layout (blocks per row)
+  int blocks_y = 0;
+};
+
 /// Integrates one batch of beams (one scan) as described above. `scratch` (optional) is reused
 /// between calls to avoid an allocation per scan.
 IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
-                                std::vector<std::uint32_t>* scratch = nullptr);
+                                IntegrationScratch* scratch = nullptr,
+                                ClearingWalk walk = ClearingWalk::kAuto);
 
 struct ScanIntegratorConfig {
   /// Largest accepted obstacle / raytrace range (m): 10 km, beyond any range sensor. A larger
@@ -113,6 +146,10 @@ class ScanIntegrator {
  public:
   explicit ScanIntegrator(const ScanIntegratorConfig& config = {});
   const ScanIntegratorConfig& config() const { return config_; }
+  /// The clearing walk (kAuto unless set; the per-ray walk is the reference for tests and
+  /// benchmarks). Every choice gives the same grid bit for bit.
+  void setClearingWalk(ClearingWalk walk) { walk_ = walk; }
+  ClearingWalk clearingWalk() const { return walk_; }
 
   /// REP-117 decisions for each beam (see the file comment), with the sensor at `sensor_pose`
   /// in the grid's frame. Appends to *beams; counts ignored beams into *stats.
@@ -160,7 +197,8 @@ class ScanIntegrator {
 
   ScanIntegratorConfig config_;
   std::vector<BeamUpdate> scratch_;
-  std::vector<std::uint32_t> flagged_scratch_;
+  IntegrationScratch integration_scratch_;
+  ClearingWalk walk_ = ClearingWalk::kAuto;
 };
 
 }  // namespace downstream_perception
