@@ -6,13 +6,14 @@
 #   make test-sanitize   ASan+UBSan build (.ws-san) running the gtests and the pytests
 #   make fuzz            fixed-seed fuzz campaign (FUZZ_CASES=20000 by default, FUZZ_SEED=17)
 #   make fuzz-sanitize   the binding part of that campaign against the sanitized module
+#   make pip-check       pip install . in a fresh venv without ROS, then the pytests there
 # Soaks (README "Benchmarks"):
 #   make soak            10-minute soaks of the costmap and TSDF nodelets (SOAK_MINUTES=10,
 #                        SOAK_ONLY=costmap|tsdf): RSS and messages handled, out/soak.md
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build install-check test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d soak lint clean
+.PHONY: help deps build install-check pip-check test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d soak lint clean
 
 FUZZ_CASES ?= 20000
 FUZZ_SEED ?= 17
@@ -20,7 +21,7 @@ SOAK_MINUTES ?= 10
 SOAK_ONLY ?=
 
 help:
-	@echo "make demo | make test | make install-check | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make soak | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make install-check | make pip-check | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make soak | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -38,6 +39,10 @@ install-check: build
 
 test-sanitize: deps
 	@tools/test_sanitize.sh
+
+# pyproject.toml: the ROS-free core as a Python package (README "Python without ROS").
+pip-check: deps
+	@tools/pip_check.sh
 
 # The message-check driver is built only here (EXCLUDE_FROM_ALL in CMakeLists.txt).
 fuzz: build

@@ -35,7 +35,9 @@ namespace {
 
 // LogOddsConfig, LogOddsGrid and the probability conversions.
 void bindLogOddsGrid(py::module& m) {
-  py::class_<LogOddsConfig>(m, "LogOddsConfig")
+  py::class_<LogOddsConfig>(m, "LogOddsConfig",
+                            "Inverse sensor model and thresholds of the log-odds obstacle grid "
+                            "(probabilities, log-odds).")
       .def(py::init<>())
       .def_readwrite("p_hit", &LogOddsConfig::p_hit)
       .def_readwrite("p_miss", &LogOddsConfig::p_miss)
@@ -48,7 +50,7 @@ void bindLogOddsGrid(py::module& m) {
   py::class_<LogOddsGrid>(m, "LogOddsGrid",
                           "Fixed-point log-odds occupancy grid (2 bytes per cell, quantum 1/1024).")
       .def(py::init<const GridGeometry&, const LogOddsConfig&>(), py::arg("geometry"),
-           py::arg("config") = LogOddsConfig{})
+           py::arg_v("config", LogOddsConfig{}, "LogOddsConfig()"))
       .def_property_readonly("geometry", &LogOddsGrid::geometry)
       .def_property_readonly("config", &LogOddsGrid::config)
       .def_property_readonly_static("quantum", [](py::object) { return LogOddsGrid::kQuantum; })
@@ -79,39 +81,51 @@ void bindLogOddsGrid(py::module& m) {
                 g, [&g](std::size_t i) { return static_cast<std::int8_t>(g.state(i)); });
           },
           "(size_y, size_x) int8: -1 unknown, 0 free, 1 occupied (by the thresholds).")
-      .def("set_log_odds",
-           [](LogOddsGrid& g,
-              py::array_t<double, py::array::c_style | py::array::forcecast> values) {
-             const GridGeometry& geo = g.geometry();
-             if (values.ndim() != 2 || values.shape(0) != geo.sizeY() ||
-                 values.shape(1) != geo.sizeX()) {
-               throw std::invalid_argument("expected an array of shape (size_y, size_x)");
-             }
-             const double* v = values.data();
-             for (std::size_t i = 0; i < geo.cellCount(); ++i) g.setLogOdds(i, v[i]);
-           })
-      .def("add_hit",
-           [](LogOddsGrid& g, int x, int y) {
-             checkIndex(g, x, y);
-             return LogOddsGrid::dequantize(g.addHit(g.geometry().index(x, y)));
-           })
-      .def("add_miss",
-           [](LogOddsGrid& g, int x, int y) {
-             checkIndex(g, x, y);
-             return LogOddsGrid::dequantize(g.addMiss(g.geometry().index(x, y)));
-           })
-      .def("cell_log_odds",
-           [](const LogOddsGrid& g, int x, int y) {
-             checkIndex(g, x, y);
-             return g.logOdds(g.geometry().index(x, y));
-           })
-      .def("cell_probability",
-           [](const LogOddsGrid& g, int x, int y) {
-             checkIndex(g, x, y);
-             return g.probability(g.geometry().index(x, y));
-           })
-      .def("reset", &LogOddsGrid::reset)
-      .def("shift", &LogOddsGrid::shift, py::arg("dx"), py::arg("dy"))
+      .def(
+          "set_log_odds",
+          [](LogOddsGrid& g,
+             py::array_t<double, py::array::c_style | py::array::forcecast> values) {
+            const GridGeometry& geo = g.geometry();
+            if (values.ndim() != 2 || values.shape(0) != geo.sizeY() ||
+                values.shape(1) != geo.sizeX()) {
+              throw std::invalid_argument("expected an array of shape (size_y, size_x)");
+            }
+            const double* v = values.data();
+            for (std::size_t i = 0; i < geo.cellCount(); ++i) g.setLogOdds(i, v[i]);
+          },
+          "Sets every cell's log-odds from a (size_y, size_x) array (clamped, quantised).")
+      .def(
+          "add_hit",
+          [](LogOddsGrid& g, int x, int y) {
+            checkIndex(g, x, y);
+            return LogOddsGrid::dequantize(g.addHit(g.geometry().index(x, y)));
+          },
+          "Adds one hit (l_hit) to cell (x, y).")
+      .def(
+          "add_miss",
+          [](LogOddsGrid& g, int x, int y) {
+            checkIndex(g, x, y);
+            return LogOddsGrid::dequantize(g.addMiss(g.geometry().index(x, y)));
+          },
+          "Adds one miss (l_miss) to cell (x, y).")
+      .def(
+          "cell_log_odds",
+          [](const LogOddsGrid& g, int x, int y) {
+            checkIndex(g, x, y);
+            return g.logOdds(g.geometry().index(x, y));
+          },
+          "The log-odds of cell (x, y).")
+      .def(
+          "cell_probability",
+          [](const LogOddsGrid& g, int x, int y) {
+            checkIndex(g, x, y);
+            return g.probability(g.geometry().index(x, y));
+          },
+          "The occupancy probability of cell (x, y).")
+      .def("reset", &LogOddsGrid::reset, "All cells back to unknown (log-odds 0).")
+      .def("shift", &LogOddsGrid::shift, py::arg("dx"), py::arg("dy"),
+           "Moves the grid's origin by (dx, dy) whole cells (rolling window); cells that come into "
+           "view are unknown.")
       .def(
           "decay",
           [](LogOddsGrid& self, double factor) {
@@ -125,7 +139,8 @@ void bindLogOddsGrid(py::module& m) {
           py::arg("factor"),
           "Every cell's log-odds times factor in [0, 1] (exp(-dt / tau)), rounded toward zero. "
           "Returns how many cells changed state.")
-      .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds)
+      .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds,
+           "Largest |log-odds| over the grid (health metric: at the clamp, never beyond).")
       .def_property_readonly("memory_bytes", &LogOddsGrid::memoryBytes);
 
   m.def("log_odds_of", &LogOddsGrid::logOddsOf, "log(p / (1 - p))");
@@ -134,7 +149,9 @@ void bindLogOddsGrid(py::module& m) {
 
 // Scans and clouds into a log-odds grid: ScanIntegrator with its config and stats.
 void bindScanIntegration(py::module& m) {
-  py::class_<ScanIntegratorConfig>(m, "ScanIntegratorConfig")
+  py::class_<ScanIntegratorConfig>(
+      m, "ScanIntegratorConfig",
+      "Ranges (m) and REP-117 options of the scan integrator (costmap_2d's obstacle-source keys).")
       .def(py::init<>())
       .def_readwrite("marking", &ScanIntegratorConfig::marking)
       .def_readwrite("clearing", &ScanIntegratorConfig::clearing)
@@ -144,9 +161,13 @@ void bindScanIntegration(py::module& m) {
       .def_readwrite("raytrace_max_range", &ScanIntegratorConfig::raytrace_max_range)
       .def_readwrite("inf_is_valid", &ScanIntegratorConfig::inf_is_valid)
       .def_readwrite("range_max_is_no_return", &ScanIntegratorConfig::range_max_is_no_return)
-      .def("validate", &ScanIntegratorConfig::validate);
+      .def("validate", &ScanIntegratorConfig::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).");
 
-  py::class_<IntegrationStats>(m, "IntegrationStats")
+  py::class_<IntegrationStats>(m, "IntegrationStats",
+                               "What one scan integration did: beams by kind, cells cleared, "
+                               "marked and changed, touched and changed windows.")
       .def_readonly("beams", &IntegrationStats::beams)
       .def_readonly("beams_marked", &IntegrationStats::beams_marked)
       .def_readonly("beams_no_return", &IntegrationStats::beams_no_return)
@@ -162,10 +183,14 @@ void bindScanIntegration(py::module& m) {
           "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
       .def_property_readonly("changed",
                              [](const IntegrationStats& s) { return boundsToTuple(s.changed); })
-      .def("clear_mark_ratio", &IntegrationStats::clearMarkRatio);
+      .def("clear_mark_ratio", &IntegrationStats::clearMarkRatio,
+           "Cells cleared per cell marked (the phantom-wall diagnostic; healthy >> 1).");
 
-  py::class_<ScanIntegrator>(m, "ScanIntegrator")
-      .def(py::init<const ScanIntegratorConfig&>(), py::arg("config") = ScanIntegratorConfig{})
+  py::class_<ScanIntegrator>(m, "ScanIntegrator",
+                             "Integrates laser scans (ranges in metres) into a LogOddsGrid: hits "
+                             "first, then each cell cleared at most once per scan.")
+      .def(py::init<const ScanIntegratorConfig&>(),
+           py::arg_v("config", ScanIntegratorConfig{}, "ScanIntegratorConfig()"))
       .def_property_readonly("config", &ScanIntegrator::config)
       .def(
           "integrate",
@@ -252,7 +277,9 @@ void bindScanIntegration(py::module& m) {
 
 // The static map layer and its occupancy-grid conversion.
 void bindStaticMap(py::module& m) {
-  py::class_<StaticMapConfig>(m, "StaticMapConfig")
+  py::class_<StaticMapConfig>(m, "StaticMapConfig",
+                              "How an OccupancyGrid becomes costs (map_server's thresholds, "
+                              "track_unknown_space, trinary_costmap).")
       .def(py::init<>())
       .def_readwrite("track_unknown_space", &StaticMapConfig::track_unknown_space)
       .def_readwrite("use_maximum", &StaticMapConfig::use_maximum)
@@ -276,11 +303,14 @@ void bindStaticMap(py::module& m) {
         }
         return out;
       },
-      py::arg("occupancy"), py::arg("config") = StaticMapConfig(),
+      py::arg("occupancy"), py::arg_v("config", StaticMapConfig{}, "StaticMapConfig()"),
       "nav_msgs/OccupancyGrid values (int8, any shape) -> costs, costmap_2d's StaticLayer "
       "mapping.");
-  py::class_<StaticMap>(m, "StaticMap")
-      .def(py::init<const StaticMapConfig&>(), py::arg("config") = StaticMapConfig())
+  py::class_<StaticMap>(m, "StaticMap",
+                        "A static map (nav_msgs/OccupancyGrid values) as costmap costs, with "
+                        "costmap_2d StaticLayer's translation.")
+      .def(py::init<const StaticMapConfig&>(),
+           py::arg_v("config", StaticMapConfig{}, "StaticMapConfig()"))
       .def(
           "set_map",
           [](StaticMap& self,
@@ -333,7 +363,9 @@ void bindStaticMap(py::module& m) {
 
 // Inflation (cost, inflate) and the footprint helpers.
 void bindInflationAndFootprint(py::module& m) {
-  py::class_<InflationConfig>(m, "InflationConfig")
+  py::class_<InflationConfig>(m, "InflationConfig",
+                              "Inflation radius and inscribed radius (m) and cost_scaling_factor "
+                              "(1/m), as costmap_2d's InflationLayer.")
       .def(py::init<>())
       .def_readwrite("inflation_radius", &InflationConfig::inflation_radius, "m")
       .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor, "1/m")
@@ -341,7 +373,9 @@ void bindInflationAndFootprint(py::module& m) {
       .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown)
       .def_readonly_static("MAX_RADIUS_CELLS", &InflationConfig::kMaxRadiusCells,
                            "largest inflation_radius / resolution accepted")
-      .def("validate", py::overload_cast<>(&InflationConfig::validate, py::const_))
+      .def("validate", py::overload_cast<>(&InflationConfig::validate, py::const_),
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).")
       .def("validate", py::overload_cast<double>(&InflationConfig::validate, py::const_),
            py::arg("resolution_m"), "Also checks the radius in cells at this resolution.");
   m.def("inflation_cost", &inflationCost, py::arg("distance_m"), py::arg("config"),

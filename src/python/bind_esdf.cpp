@@ -59,12 +59,17 @@ py::dict knownVoxels(const Esdf& esdf) {
 }  // namespace
 
 void bindEsdf(py::module& m) {
-  py::class_<EsdfConfig>(m, "EsdfConfig")
+  py::class_<EsdfConfig>(
+      m, "EsdfConfig",
+      "Parameters of the Euclidean signed distance field computed from the TSDF (metres).")
       .def(py::init<>())
       .def_readwrite("max_distance_m", &EsdfConfig::max_distance_m,
                      "distances are clamped at this (m); also a change's reach")
-      .def("validate", &EsdfConfig::validate, py::arg("voxel_size_m"));
-  py::class_<EsdfUpdateStats>(m, "EsdfUpdateStats")
+      .def("validate", &EsdfConfig::validate, py::arg("voxel_size_m"),
+           "Empty string if valid for TSDF voxels of voxel_size_m (m), else the reason.");
+  py::class_<EsdfUpdateStats>(
+      m, "EsdfUpdateStats",
+      "What one ESDF update did: full or incremental, regions, voxels changed.")
       .def_readonly("full", &EsdfUpdateStats::full)
       .def_readonly("blocks_read", &EsdfUpdateStats::blocks_read)
       .def_readonly("blocks_removed", &EsdfUpdateStats::blocks_removed)

@@ -49,14 +49,16 @@ void bindGrid(py::module& m) {
             return py::make_tuple(c.x, c.y);
           },
           "Cell (x, y) containing the point, by floor; may lie outside the grid.")
-      .def("in_bounds", &GridGeometry::inBounds)
-      .def("cell_centre",
-           [](const GridGeometry& g, int x, int y) {
-             double wx = 0;
-             double wy = 0;
-             g.cellCentre(x, y, &wx, &wy);
-             return py::make_tuple(wx, wy);
-           })
+      .def("in_bounds", &GridGeometry::inBounds, "Whether cell (x, y) lies inside the grid.")
+      .def(
+          "cell_centre",
+          [](const GridGeometry& g, int x, int y) {
+            double wx = 0;
+            double wy = 0;
+            g.cellCentre(x, y, &wx, &wy);
+            return py::make_tuple(wx, wy);
+          },
+          "World coordinates (m) of the centre of cell (x, y).")
       .def("__repr__", [](const GridGeometry& g) {
         return "GridGeometry(" + std::to_string(g.sizeX()) + ", " + std::to_string(g.sizeY()) +
                ", " + std::to_string(g.resolution()) + ", " + std::to_string(g.originX()) + ", " +
@@ -78,19 +80,23 @@ void bindGrid(py::module& m) {
       "Every cell the world segment crosses (Amanatides-Woo), clipped to the grid, in order.");
 
   // ----------------------------------------------------------------- SE(2)
-  py::class_<Pose2D>(m, "Pose2D")
+  py::class_<Pose2D>(
+      m, "Pose2D",
+      "A 2-D pose (x, y in metres, yaw in radians, REP-103): child frame in parent frame.")
       .def(py::init<double, double, double>(), py::arg("x") = 0.0, py::arg("y") = 0.0,
            py::arg("yaw") = 0.0)
       .def_readwrite("x", &Pose2D::x)
       .def_readwrite("y", &Pose2D::y)
       .def_readwrite("yaw", &Pose2D::yaw)
-      .def("as_tuple", [](const Pose2D& p) { return py::make_tuple(p.x, p.y, p.yaw); })
+      .def(
+          "as_tuple", [](const Pose2D& p) { return py::make_tuple(p.x, p.y, p.yaw); },
+          "(x, y, yaw) as a tuple.")
       .def("__repr__", [](const Pose2D& p) {
         return "Pose2D(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
                std::to_string(p.yaw) + ")";
       });
   m.def("compose", &compose, "a ∘ b (parent<-mid ∘ mid<-child = parent<-child)");
-  m.def("inverse", &inverse);
+  m.def("inverse", &inverse, "The inverse pose: child <- parent from parent <- child.");
   m.def(
       "apply",
       [](const Pose2D& a, py::array_t<double, py::array::c_style | py::array::forcecast> points) {
@@ -110,8 +116,9 @@ void bindGrid(py::module& m) {
       "R p + t for each row of an (N, 2) array.");
   m.def("interpolate", &interpolate, py::arg("a"), py::arg("t_a"), py::arg("b"), py::arg("t_b"),
         py::arg("t"), "Linear in translation, shortest arc in yaw.");
-  m.def("normalize_angle", &normalizeAngle);
-  m.def("shortest_angular_distance", &shortestAngularDistance);
+  m.def("normalize_angle", &normalizeAngle, "The angle (rad) wrapped into [-pi, pi).");
+  m.def("shortest_angular_distance", &shortestAngularDistance,
+        "Signed shortest rotation (rad) from angle `from` to angle `to`.");
 
   // ----------------------------------------------------------------- costs
   m.attr("FREE_SPACE") = cost::kFreeSpace;

@@ -37,7 +37,9 @@ void bindHandoff(py::module& m) {
       .def_readwrite("max_transform_age_s", &SeamLimits::max_transform_age_s, "s")
       .def_readwrite("max_smear_m", &SeamLimits::max_smear_m, "m")
       .def_readwrite("max_map_odom_age_s", &SeamLimits::max_map_odom_age_s, "s");
-  py::class_<CorrectionMonitorConfig>(m, "CorrectionMonitorConfig")
+  py::class_<CorrectionMonitorConfig>(
+      m, "CorrectionMonitorConfig",
+      "Limits of the map <- odom correction monitor (metres, seconds).")
       .def(py::init<>())
       .def_readwrite("window_s", &CorrectionMonitorConfig::window_s, "s")
       .def_readwrite("reset_drop_m", &CorrectionMonitorConfig::reset_drop_m, "m")
@@ -45,12 +47,16 @@ void bindHandoff(py::module& m) {
       .def_readwrite("zero_epsilon_m", &CorrectionMonitorConfig::zero_epsilon_m, "m")
       .def_readwrite("min_travel_m", &CorrectionMonitorConfig::min_travel_m, "m")
       .def_readwrite("ramp_m", &CorrectionMonitorConfig::ramp_m, "m")
-      .def("validate", &CorrectionMonitorConfig::validate);
+      .def("validate", &CorrectionMonitorConfig::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).");
   py::class_<CorrectionMonitor>(m, "CorrectionMonitor", "Watches |map <- odom| over time.")
       .def(py::init<const CorrectionMonitorConfig&>(),
-           py::arg("config") = CorrectionMonitorConfig())
+           py::arg_v("config", CorrectionMonitorConfig{}, "CorrectionMonitorConfig()"))
       .def("add", &CorrectionMonitor::add, py::arg("time_s"), py::arg("correction_m"),
-           py::arg("travelled_m"))
+           py::arg("travelled_m"),
+           "One sample: time (s), the correction's translation magnitude (m), the distance "
+           "travelled so far (m).")
       .def(
           "add_many",
           [](CorrectionMonitor& m, const Eigen::VectorXd& t, const Eigen::VectorXd& c,
@@ -60,10 +66,16 @@ void bindHandoff(py::module& m) {
             }
             for (Eigen::Index i = 0; i < t.size(); ++i) m.add(t[i], c[i], d[i]);
           },
-          py::arg("time_s"), py::arg("correction_m"), py::arg("travelled_m"))
+          py::arg("time_s"), py::arg("correction_m"), py::arg("travelled_m"),
+          "Samples from three equally long arrays: time_s, correction_m, travelled_m.")
       .def_property_readonly("resets", &CorrectionMonitor::resets)
-      .def("never_resets", &CorrectionMonitor::neverResets)
-      .def("stuck_at_zero", &CorrectionMonitor::stuckAtZero)
-      .def("too_large", &CorrectionMonitor::tooLarge)
-      .def("findings", &CorrectionMonitor::findings);
+      .def("never_resets", &CorrectionMonitor::neverResets,
+           "Whether the correction grew by ramp_m over the window without a reset.")
+      .def("stuck_at_zero", &CorrectionMonitor::stuckAtZero,
+           "Whether the correction stayed ~0 over the window while the robot travelled "
+           "min_travel_m.")
+      .def("too_large", &CorrectionMonitor::tooLarge,
+           "Whether the latest correction exceeds max_correction_m.")
+      .def("findings", &CorrectionMonitor::findings,
+           "What is wrong, one line per finding (empty if healthy).");
 }

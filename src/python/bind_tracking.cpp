@@ -78,7 +78,9 @@ void bindTracking(py::module& m) {
       },
       py::arg("a"), py::arg("b"), "IoU of two binary masks (non-zero = foreground).");
   // ----------------------------------------------------------------- predicted obstacles
-  py::class_<PredictionConfig>(m, "PredictionConfig")
+  py::class_<PredictionConfig>(m, "PredictionConfig",
+                               "How tracks are predicted into the costmap: horizon and step (s), "
+                               "uncertainty growth, footprint margin (m).")
       .def(py::init<>())
       .def_readwrite("prediction_horizon_s", &PredictionConfig::prediction_horizon_s, "s")
       .def_readwrite("uncertainty_sigmas", &PredictionConfig::uncertainty_sigmas)
@@ -86,7 +88,9 @@ void bindTracking(py::module& m) {
       .def_readwrite("min_object_size_m", &PredictionConfig::min_object_size_m, "m")
       .def_readwrite("max_object_size_m", &PredictionConfig::max_object_size_m, "m")
       .def_readwrite("max_speed_mps", &PredictionConfig::max_speed_mps, "m/s")
-      .def("validate", &PredictionConfig::validate);
+      .def("validate", &PredictionConfig::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).");
   py::class_<PlanarTrack>(m, "PlanarTrack", "One track in the costmap's frame.")
       .def(py::init([](const Eigen::Vector2d& position, const Eigen::Vector2d& velocity,
                        const Eigen::Matrix2d& position_covariance,
@@ -113,7 +117,9 @@ void bindTracking(py::module& m) {
       .def_readwrite("size_x", &PlanarTrack::size_x, "m")
       .def_readwrite("size_y", &PlanarTrack::size_y, "m")
       .def_readwrite("box_yaw", &PlanarTrack::box_yaw, "rad")
-      .def("validate", &PlanarTrack::validate);
+      .def("validate", &PlanarTrack::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).");
   m.def("uncertainty_radius", &uncertaintyRadius, py::arg("track"), py::arg("dt_s"),
         py::arg("config"), "k sigma of the predicted position dt_s after the stamp, m (capped).");
   m.def(
@@ -176,7 +182,9 @@ void bindTracking(py::module& m) {
       .value("TENTATIVE", TrackState::kTentative)
       .value("CONFIRMED", TrackState::kConfirmed)
       .value("COASTING", TrackState::kCoasting);
-  py::class_<TrackerConfig> tc(m, "TrackerConfig");
+  py::class_<TrackerConfig> tc(m, "TrackerConfig",
+                               "Tracker parameters; metric defaults on construction, image "
+                               "defaults from TrackerConfig.defaults_for(Mode.IMAGE).");
   py::enum_<TrackerConfig::Mode>(tc, "Mode")
       .value("METRIC", TrackerConfig::Mode::kMetric)
       .value("IMAGE", TrackerConfig::Mode::kImage);
@@ -199,14 +207,18 @@ void bindTracking(py::module& m) {
       .def_readwrite("low_score", &TrackerConfig::low_score)
       .def_readwrite("second_pass", &TrackerConfig::second_pass)
       .def_readwrite("class_aware", &TrackerConfig::class_aware)
-      .def("validate", &TrackerConfig::validate)
+      .def("validate", &TrackerConfig::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).")
       .def_static("defaults_for", &TrackerConfig::defaultsFor, py::arg("mode"),
                   "The mode's documented defaults. TrackerConfig() is the metric ones; setting "
                   "mode on it keeps every other field as it is.")
       .def_static("mode_specific_defaults", &TrackerConfig::modeSpecificDefaults, py::arg("mode"),
                   "[(name, value)] of the fields whose default in this mode differs from the "
                   "metric one.");
-  py::class_<TrackerStats>(m, "TrackerStats")
+  py::class_<TrackerStats>(m, "TrackerStats",
+                           "What one tracker step did: detections by kind, matches per pass, "
+                           "births, deaths, duplicates, re-identifications.")
       .def_readonly("detections", &TrackerStats::detections)
       .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score)
       .def_readonly("detections_rejected_invalid", &TrackerStats::detections_rejected_invalid)
@@ -224,7 +236,8 @@ void bindTracking(py::module& m) {
       .def_readonly("confirmed", &TrackerStats::confirmed);
   py::class_<Tracker>(m, "Tracker",
                       "SORT-style multi-object tracker (see core/tracking/tracker.h).")
-      .def(py::init<const TrackerConfig&>(), py::arg("config") = TrackerConfig{})
+      .def(py::init<const TrackerConfig&>(),
+           py::arg_v("config", TrackerConfig{}, "TrackerConfig()"))
       .def(
           "step",
           [](Tracker& self, double stamp,
@@ -338,5 +351,5 @@ void bindTracking(py::module& m) {
           "include_tentative=False leaves out the tracks not yet confirmed.")
       .def("last_assignment", &Tracker::lastAssignment,
            "Per detection of the last step: the id of the track that took it, or 0.")
-      .def("reset", &Tracker::reset);
+      .def("reset", &Tracker::reset, "Forgets every track (ids keep counting up).");
 }

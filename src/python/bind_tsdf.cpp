@@ -71,7 +71,9 @@ std::vector<Eigen::Vector3d> toPoints(const PointsRows& rows) {
 }
 
 void bindOctree(py::module& m) {
-  py::class_<OctreeConfig>(m, "OctreeConfig")
+  py::class_<OctreeConfig>(
+      m, "OctreeConfig",
+      "Parameters of the OctoMap occupancy octree (metres, probabilities, bytes).")
       .def(py::init<>())
       .def_readwrite("resolution_m", &OctreeConfig::resolution_m)
       .def_readwrite("prob_hit", &OctreeConfig::prob_hit)
@@ -80,10 +82,29 @@ void bindOctree(py::module& m) {
       .def_readwrite("depth_stride_px", &OctreeConfig::depth_stride_px)
       .def_readwrite("max_distance_m", &OctreeConfig::max_distance_m)
       .def_readwrite("max_memory_bytes", &OctreeConfig::max_memory_bytes)
-      .def("validate", &OctreeConfig::validate);
+      .def("validate", &OctreeConfig::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).");
+  // Before the octree, whose insert_depth takes a camera (the signature names the Python type).
+  py::class_<PinholeCamera>(m, "PinholeCamera",
+                            "Pinhole intrinsics (pixels), ROS optical convention.")
+      .def(py::init([](double fx, double fy, double cx, double cy, int width, int height) {
+             PinholeCamera c{fx, fy, cx, cy, width, height};
+             const std::string why = c.validate();
+             if (!why.empty()) throw std::invalid_argument("camera: " + why);
+             return c;
+           }),
+           py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"),
+           py::arg("height"))
+      .def_readonly("fx", &PinholeCamera::fx)
+      .def_readonly("fy", &PinholeCamera::fy)
+      .def_readonly("cx", &PinholeCamera::cx)
+      .def_readonly("cy", &PinholeCamera::cy)
+      .def_readonly("width", &PinholeCamera::width)
+      .def_readonly("height", &PinholeCamera::height);
   py::class_<OccupancyOctree>(m, "OccupancyOctree",
                               "OctoMap occupancy (octomap::OcTree) from the same observations.")
-      .def(py::init<const OctreeConfig&>(), py::arg("config") = OctreeConfig{})
+      .def(py::init<const OctreeConfig&>(), py::arg_v("config", OctreeConfig{}, "OctreeConfig()"))
       .def(
           "insert_points",
           [](OccupancyOctree& self, const PointsRows& points, const Eigen::Vector3d& origin) {
@@ -91,7 +112,8 @@ void bindOctree(py::module& m) {
             py::gil_scoped_release release;
             self.insertPoints(p, origin);
           },
-          py::arg("points"), py::arg("origin"))
+          py::arg("points"), py::arg("origin"),
+          "Inserts an (N, 3) point cloud (m) seen from `origin`: rays cleared, end points marked.")
       .def(
           "insert_depth",
           [](OccupancyOctree& self,
@@ -105,7 +127,8 @@ void bindOctree(py::module& m) {
             py::gil_scoped_release release;
             self.insertDepth(depth.data(), camera, pose);
           },
-          py::arg("depth"), py::arg("camera"), py::arg("T_map_camera"))
+          py::arg("depth"), py::arg("camera"), py::arg("T_map_camera"),
+          "Inserts a depth image (m, (height, width)) seen by `camera` at the given pose.")
       .def(
           "log_odds",
           [](const OccupancyOctree& self, const PointsRows& points) {
@@ -135,7 +158,8 @@ void bindOctree(py::module& m) {
             const std::string why = self.writeBinary(path);
             if (!why.empty()) throw std::runtime_error(why);
           },
-          py::arg("path"))
+          py::arg("path"),
+          "Writes the octree as an OctoMap .bt file (refuses to overwrite unless asked).")
       .def(
           "evict_farther_than",
           [](OccupancyOctree& self, const Eigen::Vector3d& center, double distance_m) {
@@ -166,7 +190,7 @@ void bindOctree(py::module& m) {
       .def_property_readonly("node_count", &OccupancyOctree::nodeCount)
       .def_property_readonly("leaf_count", &OccupancyOctree::leafCount)
       .def_property_readonly("memory_bytes", &OccupancyOctree::memoryBytes)
-      .def("clear", &OccupancyOctree::clear);
+      .def("clear", &OccupancyOctree::clear, "Forgets every node.");
 }
 
 void bindTsdf(py::module& m) {
@@ -174,7 +198,9 @@ void bindTsdf(py::module& m) {
   py::enum_<TsdfConfig::Weighting>(m, "TsdfWeighting")
       .value("CONSTANT", TsdfConfig::Weighting::kConstant)
       .value("INVERSE_SQUARE_DEPTH", TsdfConfig::Weighting::kInverseSquareDepth);
-  py::class_<TsdfConfig>(m, "TsdfConfig")
+  py::class_<TsdfConfig>(m, "TsdfConfig",
+                         "Parameters of the sparse TSDF (voxel size and truncation in metres, "
+                         "weights, memory bounds).")
       .def(py::init<>())
       .def_readwrite("voxel_size_m", &TsdfConfig::voxel_size_m)
       .def_readwrite("truncation_voxels", &TsdfConfig::truncation_voxels)
@@ -192,24 +218,12 @@ void bindTsdf(py::module& m) {
       .def_readwrite("max_blocks", &TsdfConfig::max_blocks)
       .def_readwrite("max_block_distance_m", &TsdfConfig::max_block_distance_m)
       .def("truncation", &TsdfConfig::truncation, "mu in metres")
-      .def("validate", &TsdfConfig::validate);
-  py::class_<PinholeCamera>(m, "PinholeCamera",
-                            "Pinhole intrinsics (pixels), ROS optical convention.")
-      .def(py::init([](double fx, double fy, double cx, double cy, int width, int height) {
-             PinholeCamera c{fx, fy, cx, cy, width, height};
-             const std::string why = c.validate();
-             if (!why.empty()) throw std::invalid_argument("camera: " + why);
-             return c;
-           }),
-           py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"),
-           py::arg("height"))
-      .def_readonly("fx", &PinholeCamera::fx)
-      .def_readonly("fy", &PinholeCamera::fy)
-      .def_readonly("cx", &PinholeCamera::cx)
-      .def_readonly("cy", &PinholeCamera::cy)
-      .def_readonly("width", &PinholeCamera::width)
-      .def_readonly("height", &PinholeCamera::height);
-  py::class_<TsdfIntegrationStats>(m, "TsdfIntegrationStats")
+      .def("validate", &TsdfConfig::validate,
+           "Empty string if the configuration is valid, else the reason (what the constructors "
+           "raise).");
+  py::class_<TsdfIntegrationStats>(m, "TsdfIntegrationStats",
+                                   "What one TSDF integration did: pixels by kind, blocks touched, "
+                                   "allocated, refused, evicted, voxels updated.")
       .def_readonly("pixels_valid", &TsdfIntegrationStats::pixels_valid)
       .def_readonly("pixels_invalid", &TsdfIntegrationStats::pixels_invalid)
       .def_readonly("pixels_no_return", &TsdfIntegrationStats::pixels_no_return)
@@ -229,7 +243,7 @@ void bindTsdf(py::module& m) {
   py::class_<Tsdf>(m, "Tsdf",
                    "Sparse TSDF (8^3-voxel blocks) with an incremental marching-cubes mesher.")
       .def(py::init([](const TsdfConfig& c) { return std::make_unique<Tsdf>(c); }),
-           py::arg("config") = TsdfConfig{})
+           py::arg_v("config", TsdfConfig{}, "TsdfConfig()"))
       .def_property_readonly("config", [](const Tsdf& t) { return t.map.config(); })
       .def(
           "set_config",
@@ -315,7 +329,7 @@ void bindTsdf(py::module& m) {
             const std::string why = self.mesher.combined().writePly(path);
             if (!why.empty()) throw std::runtime_error(why);
           },
-          py::arg("path"))
+          py::arg("path"), "Writes the welded mesh as a PLY file.")
       .def(
           "slice",
           [](const Tsdf& self, const GridGeometry& grid, double min_z_m, double max_z_m,
@@ -354,10 +368,13 @@ void bindTsdf(py::module& m) {
       .def_property_readonly(
           "blocks_evicted_to_cap", [](const Tsdf& t) { return t.map.blocksEvictedToCap(); },
           "Blocks evicted because set_config lowered max_blocks below the block count (total).")
-      .def("clear", [](Tsdf& self) {
-        self.map.clear();
-        self.mesher.clear();
-      });
+      .def(
+          "clear",
+          [](Tsdf& self) {
+            self.map.clear();
+            self.mesher.clear();
+          },
+          "Forgets every block, the mesh and the ESDF.");
 
   m.def(
       "slice_distance",

@@ -16,10 +16,9 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "downstream_perception ROS-free core (C++), with numpy arrays in and out.";
   // The package refuses numpy 2 with a pybind11 older than 2.12 (see __init__.py).
   m.attr("pybind11_version") = py::make_tuple(PYBIND11_VERSION_MAJOR, PYBIND11_VERSION_MINOR);
+  bindGrid(m);  // GridGeometry first: Tsdf.slice takes one
   bindTsdf(m);
   bindEsdf(m);
-
-  bindGrid(m);
   bindCostmap(m);
   bindTracking(m);
   bindHandoff(m);

@@ -48,6 +48,9 @@ def test_the_lists_are_not_empty() -> None:
 
 
 @pytest.mark.skipif(shutil.which("rosrun") is None, reason="rosrun is not installed")
+@pytest.mark.skipif(
+    os.environ.get("DP_PIP_PACKAGE") == "1", reason="pip package: no catkin workspace, no ROS"
+)
 @pytest.mark.parametrize("name", _scripts() + _nodes())
 def test_rosrun_finds_exactly_one(name: str) -> None:
     if name in _nodes() and os.environ.get("DP_PARTIAL_BUILD") == "1":
