@@ -1,0 +1,127 @@
+// Exact 3-D voxel traversal (Amanatides-Woo) of a segment inside a box of voxels.
+//
+// Coordinates are in voxel units relative to the box's lower corner: voxel (i, j, k) is the
+// half-open cube [i, i+1) x [j, j+1) x [k, k+1), so a point exactly on a face belongs to the voxel
+// above it (floor), as GridGeometry::worldToCell does in 2-D.
+//
+// What is visited (the contract the gtest checks against a brute-force slab oracle): the voxel of
+// the start point, then every voxel in which the segment spends a positive length, in order, each
+// once; the voxel of the end point last (only when include_end). A voxel the segment touches at a
+// single point or along an edge line only (a ray through a corner) is not visited: its interior is
+// not crossed, and visiting it would clear a voxel on one side of the ray only.
+//
+// Exactness: the end points are first rounded to 2^-20 voxel (fixed point, int64); everything
+// after that is integer arithmetic. Which face is crossed next compares the crossing parameters
+// t_a = N_a / d_a of the three axes; scaled by the product P of the non-zero |d_a| they become the
+// integers T_a = N_a * P / d_a (__int128: the box is at most 2^16 voxels per axis, so N_a < 2^36,
+// P < 2^108 and T_a < 2^108), and ties (the segment through an edge or a corner) are exact
+// equalities, crossed in one diagonal step. No epsilon anywhere: lattice-exact rays (simulated
+// walls, tests) are walked exactly like measured ones.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace downstream_perception {
+
+/// GCC/Clang's 128-bit integer (__extension__: not ISO C++, but exact and cheap here).
+__extension__ typedef __int128 Int128;
+
+/// A box of voxels [0, nx) x [0, ny) x [0, nz).
+struct VoxelBox {
+  static constexpr int kMaxVoxelsPerAxis = 1 << 16;
+  int nx = 0;
+  int ny = 0;
+  int nz = 0;
+  bool valid() const {
+    return nx > 0 && ny > 0 && nz > 0 && nx <= kMaxVoxelsPerAxis && ny <= kMaxVoxelsPerAxis &&
+           nz <= kMaxVoxelsPerAxis;
+  }
+};
+
+struct VoxelIndex {
+  int x = 0;
+  int y = 0;
+  int z = 0;
+  bool operator==(const VoxelIndex& o) const { return x == o.x && y == o.y && z == o.z; }
+  bool operator!=(const VoxelIndex& o) const { return !(*this == o); }
+};
+
+/// A segment in fixed point (units of 2^-20 voxel, box-relative, each coordinate in
+/// [0, n * 2^20 - 1]).
+struct FixedSegment {
+  static constexpr int kShift = 20;
+  static constexpr std::int64_t kOne = std::int64_t{1} << kShift;
+  std::array<std::int64_t, 3> p0{};
+  std::array<std::int64_t, 3> p1{};
+};
+
+/// Clips the segment p0-p1 (voxel units, box-relative) to the box and rounds it to fixed point.
+/// Returns false when it misses the box or is not finite. *end_clipped tells whether the end was
+/// moved (then its voxel is not the measurement's). A moved end lies on the face it was moved to
+/// (an upper face: one fixed-point unit inside, the face itself belongs to the voxel beyond).
+bool clipToFixed(const VoxelBox& box, const double p0[3], const double p1[3], FixedSegment* out,
+                 bool* end_clipped = nullptr);
+
+/// The walk's state; see the file comment.
+class VoxelWalk {
+ public:
+  explicit VoxelWalk(const FixedSegment& s);
+
+  const std::array<int, 3>& start() const { return start_; }
+  std::array<int, 3> end() const {
+    return {start_[0] + step_[0] * steps_[0], start_[1] + step_[1] * steps_[1],
+            start_[2] + step_[2] * steps_[2]};
+  }
+
+  /// Calls visit(x, y, z) for each voxel of the segment in order; the end voxel only when
+  /// include_end. Returns the number of visits.
+  template <class Visitor>
+  int walk(bool include_end, Visitor&& visit) const {
+    int c[3] = {start_[0], start_[1], start_[2]};
+    int left[3] = {steps_[0], steps_[1], steps_[2]};
+    Int128 t[3] = {t_next_[0], t_next_[1], t_next_[2]};
+    int visits = 0;
+    while (left[0] + left[1] + left[2] > 0) {
+      visit(c[0], c[1], c[2]);
+      ++visits;
+      // The earliest next crossing among the axes that still cross a face before the end (an
+      // axis with no steps left crosses at t >= 1 only, never before those that do).
+      Int128 tmin = 0;
+      bool any = false;
+      for (int a = 0; a < 3; ++a) {
+        if (left[a] > 0 && (!any || t[a] < tmin)) {
+          tmin = t[a];
+          any = true;
+        }
+      }
+      for (int a = 0; a < 3; ++a) {
+        if (left[a] > 0 && t[a] == tmin) {  // ties: an edge or a corner, one diagonal step
+          c[a] += step_[a];
+          t[a] += t_delta_[a];
+          --left[a];
+        }
+      }
+    }
+    if (include_end) {
+      visit(c[0], c[1], c[2]);
+      ++visits;
+    }
+    return visits;
+  }
+
+ private:
+  std::array<int, 3> start_{};
+  std::array<int, 3> step_{};
+  std::array<int, 3> steps_{};
+  std::array<Int128, 3> t_next_{};
+  std::array<Int128, 3> t_delta_{};
+};
+
+/// Convenience form (tests, Python): the voxels of the segment p0-p1 (voxel units, box-relative),
+/// clipped to the box. The end voxel is included when include_end or when the end was clipped.
+std::vector<VoxelIndex> voxelRay(const VoxelBox& box, const double p0[3], const double p1[3],
+                                 bool include_end = true);
+
+}  // namespace downstream_perception
