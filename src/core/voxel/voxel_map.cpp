@@ -34,6 +34,27 @@ std::string windowProblem(int x0, int y0, int nx, int ny) {
   return why.str();
 }
 
+// Bytes of the block pointer table a window needs (it counts against max_memory_mib too: a
+// 65536 x 65536 window would need a gigabyte of null pointers).
+std::int64_t tableBytes(int x0, int y0, int nx, int ny, int z_voxels) {
+  constexpr int kE = VoxelBlock::kEdge;
+  const std::int64_t nbx = floorDiv(x0 + nx - 1, kE) - floorDiv(x0, kE) + 1;
+  const std::int64_t nby = floorDiv(y0 + ny - 1, kE) - floorDiv(y0, kE) + 1;
+  const std::int64_t nbz = (z_voxels + kE - 1) / kE;
+  return nbx * nby * nbz * static_cast<std::int64_t>(sizeof(std::unique_ptr<VoxelBlock>));
+}
+
+std::string tableProblem(const VoxelMapConfig& c, int x0, int y0, int nx, int ny) {
+  const std::int64_t bytes = tableBytes(x0, y0, nx, ny, c.z_voxels);
+  if (static_cast<double>(bytes) > c.max_memory_mib * 1048576.0) {
+    std::ostringstream why;
+    why << "a " << nx << " x " << ny << " x " << c.z_voxels << " voxel window needs " << bytes
+        << " bytes of block table alone, more than max_memory_mib " << c.max_memory_mib;
+    return why.str();
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string VoxelMapConfig::validate() const {
@@ -103,10 +124,10 @@ VoxelMap::VoxelMap(const VoxelMapConfig& config, double anchor_x_m, double ancho
           std::to_string(anchor_y_m) + ")";
   }
   if (why.empty()) why = windowProblem(0, 0, nx, ny);
+  if (why.empty()) why = tableProblem(config, 0, 0, nx, ny);
   if (!why.empty()) throw std::invalid_argument("voxel map: " + why);
   hit_ = static_cast<float>(LogOddsGrid::logOddsOf(config.log_odds.p_hit));
   miss_ = static_cast<float>(LogOddsGrid::logOddsOf(config.log_odds.p_miss));
-  max_blocks_ = static_cast<std::size_t>(config.max_memory_mib * 1048576.0 / sizeof(VoxelBlock));
   const double zr = config.z_resolution_m;
   band_first_ = static_cast<int>(
       std::max(0.0, std::ceil((config.min_obstacle_height_m - config.origin_z_m) / zr - 0.5)));
@@ -118,7 +139,8 @@ VoxelMap::VoxelMap(const VoxelMapConfig& config, double anchor_x_m, double ancho
 }
 
 void VoxelMap::setWindow(int x0, int y0, int nx, int ny) {
-  const std::string why = windowProblem(x0, y0, nx, ny);
+  std::string why = windowProblem(x0, y0, nx, ny);
+  if (why.empty()) why = tableProblem(config_, x0, y0, nx, ny);
   if (!why.empty()) throw std::invalid_argument("voxel map: " + why);
   if (x0 == x0_ && y0 == y0_ && nx == nx_ && ny == ny_) return;
   rebuildTable(x0, y0, nx, ny);
@@ -156,6 +178,11 @@ void VoxelMap::rebuildTable(int x0, int y0, int nx, int ny) {
   }
   table_ = std::move(table);
   blocks_ = kept;
+  // The blocks get what the table leaves of the budget. Blocks kept beyond it (a window grown in
+  // place) stay; no new one is taken until they are fewer.
+  const double left =
+      config_.max_memory_mib * 1048576.0 - static_cast<double>(table_.size() * sizeof(table_[0]));
+  max_blocks_ = static_cast<std::size_t>(std::max(0.0, left) / sizeof(VoxelBlock));
   x0_ = x0;
   y0_ = y0;
   nx_ = nx;

@@ -257,9 +257,9 @@ TEST(VoxelMap, DecayHandWorked) {
 
 TEST(VoxelMap, MemoryBoundDropsAndCounts) {
   VoxelMapConfig c = roomConfig();
-  c.max_memory_mib = 0.01;  // 10485 bytes: one block of 6144
+  c.max_memory_mib = 0.01;  // 10485 bytes: a table of 5 x 5 x 3 pointers (600) and one block
   VoxelMap map(c, 0.0, 0.0, 40, 40);
-  EXPECT_EQ(map.maxBlocks(), 1u);
+  EXPECT_EQ(map.maxBlocks(), 1u);  // (10485 - 600) / 6144 = 1.6
   std::vector<float> pts;
   add(&pts, 0.35, 0.35, 0.35);  // block (0, 0, 0)
   add(&pts, 2.05, 2.05, 0.35);  // block (2, 2, 0)
@@ -310,6 +310,8 @@ TEST(VoxelMap, InvalidInputIsRefusedNotCrashedOn) {
   EXPECT_THROW(VoxelMap(c, 0.0, 0.0, 10, 10), std::invalid_argument);
   EXPECT_THROW(VoxelMap(VoxelMapConfig(), nan, 0.0, 10, 10), std::invalid_argument);
   EXPECT_THROW(VoxelMap(VoxelMapConfig(), 0.0, 0.0, 100000, 10), std::invalid_argument);
+  // 65536^2 columns: 8192 x 8192 x 2 block pointers, 1 GiB, beyond the default 64 MiB.
+  EXPECT_THROW(VoxelMap(VoxelMapConfig(), 0.0, 0.0, 65536, 65536), std::invalid_argument);
   VoxelRayConfig r;
   r.raytrace_max_range_m = -1.0;
   EXPECT_NE(r.validate().find("raytrace_max_range_m"), std::string::npos);

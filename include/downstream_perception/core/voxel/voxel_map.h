@@ -60,7 +60,8 @@ class VoxelMap {
  public:
   /// A window of nx x ny columns whose voxel (0, 0, k) has its lower corner at (anchor_x_m,
   /// anchor_y_m, origin_z_m + k * z_resolution_m). Throws std::invalid_argument naming the
-  /// problem for an invalid config, a non-finite anchor or a window outside [1, 65536] voxels.
+  /// problem for an invalid config, a non-finite anchor, a window outside [1, 65536] voxels or
+  /// one whose block pointer table alone exceeds max_memory_mib.
   VoxelMap(const VoxelMapConfig& config, double anchor_x_m, double anchor_y_m, int nx, int ny);
 
   const VoxelMapConfig& config() const { return config_; }
@@ -75,7 +76,8 @@ class VoxelMap {
 
   /// Moves / resizes the window (offset x0, y0 from the anchor, in voxels). Blocks that stay are
   /// kept; voxels that leave the window are forgotten. Throws std::invalid_argument (changing
-  /// nothing) for a size outside [1, 65536] or an offset beyond +-2^30 voxels.
+  /// nothing) for a size outside [1, 65536], an offset beyond +-2^30 voxels or a block table
+  /// beyond max_memory_mib.
   void setWindow(int x0, int y0, int nx, int ny);
 
   /// Integrates one frame: `hits` are n_hits returns (x, y, z floats, world frame, m), `no_returns`
@@ -111,6 +113,7 @@ class VoxelMap {
   void clear();
 
   std::size_t blocks() const { return blocks_; }
+  /// Most blocks the memory bound allows: (max_memory_mib - table) / block size.
   std::size_t maxBlocks() const { return max_blocks_; }
   /// Bytes held: the blocks plus the pointer table.
   std::size_t memoryBytes() const {
