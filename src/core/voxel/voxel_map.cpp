@@ -321,11 +321,12 @@ VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const f
             u[2] < config_.z_voxels)) {
         continue;
       }
-      // The walk's end voxel, so that the mark is exactly the voxel the clearing ray stops at.
-      FixedSegment s;
-      if (!clipToFixed(VoxelBox{nx_, ny_, config_.z_voxels}, u, u, &s)) continue;
-      const VoxelWalk w(s);
-      update(w.start()[0], w.start()[1], w.start()[2], hit_, stamp, &stats);
+      // The walk's end voxel (the same rounding), so that the mark is exactly the voxel the
+      // clearing ray stops at.
+      const auto cell = [&u](int a, int n) {
+        return static_cast<int>(FixedSegment::toFixed(u[a], n) >> FixedSegment::kShift);
+      };
+      update(cell(0, nx_), cell(1, ny_), cell(2, config_.z_voxels), hit_, stamp, &stats);
     }
   }
   // Pass 2: every ray clears up to its return / range.

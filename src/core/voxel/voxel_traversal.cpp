@@ -5,16 +5,12 @@
 
 namespace downstream_perception {
 
-namespace {
-
-std::int64_t toFixed(double u, int cells) {
+std::int64_t FixedSegment::toFixed(double u, int cells) {
   // Clamped as a double first: casting an out-of-range double to int64 is undefined.
   const double hi = static_cast<double>(std::int64_t{cells} * FixedSegment::kOne - 1);
   const double f = std::round(u * static_cast<double>(FixedSegment::kOne));
   return static_cast<std::int64_t>(std::max(0.0, std::min(f, hi)));
 }
-
-}  // namespace
 
 bool clipToFixed(const VoxelBox& box, const double p0[3], const double p1[3], FixedSegment* out,
                  bool* end_clipped) {
@@ -58,8 +54,8 @@ bool clipToFixed(const VoxelBox& box, const double p0[3], const double p1[3], Fi
   const int cells[3] = {box.nx, box.ny, box.nz};
   for (int a = 0; a < 3; ++a) {
     const double d = p1[a] - p0[a];
-    out->p0[a] = toFixed(edge0 >= 0 ? p0[a] + t0 * d : p0[a], cells[a]);
-    out->p1[a] = toFixed(edge1 >= 0 ? p0[a] + t1 * d : p1[a], cells[a]);
+    out->p0[a] = FixedSegment::toFixed(edge0 >= 0 ? p0[a] + t0 * d : p0[a], cells[a]);
+    out->p1[a] = FixedSegment::toFixed(edge1 >= 0 ? p0[a] + t1 * d : p1[a], cells[a]);
   }
   // A moved end is put exactly on its face: p0 + t * d rounds, and at a far end (1e12 voxels)
   // the rounding is larger than a voxel. The clamp in toFixed keeps an upper face inside.

@@ -55,6 +55,10 @@ struct FixedSegment {
   static constexpr std::int64_t kOne = std::int64_t{1} << kShift;
   std::array<std::int64_t, 3> p0{};
   std::array<std::int64_t, 3> p1{};
+
+  /// A box-relative coordinate u (voxel units) in fixed point, clamped into [0, cells * kOne - 1]
+  /// (NaN to 0). Its voxel is the result >> kShift: the voxel a walk ending at u ends in.
+  static std::int64_t toFixed(double u, int cells);
 };
 
 /// Clips the segment p0-p1 (voxel units, box-relative) to the box and rounds it to fixed point.
