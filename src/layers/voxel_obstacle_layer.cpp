@@ -422,10 +422,11 @@ void VoxelObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, int 
 }
 
 void VoxelObstacleLayer::publishVoxels(const ros::Time& stamp) {
-  static thread_local ros::WallTime last;
   const ros::WallTime wall = ros::WallTime::now();
-  if (!last.isZero() && (wall - last).toSec() < kVoxelCloudPeriodS) return;
-  last = wall;
+  if (!last_voxel_cloud_.isZero() && (wall - last_voxel_cloud_).toSec() < kVoxelCloudPeriodS) {
+    return;
+  }
+  last_voxel_cloud_ = wall;
   const std::vector<Eigen::Vector3f> centres = map_->occupiedCentres(stamp.toSec());
   sensor_msgs::PointCloud2 cloud;
   cloud.header.stamp = stamp;

@@ -92,6 +92,7 @@ class VoxelObstacleLayer : public Layer {
   double prune_period_s_ = 1.0;
   ros::Time last_prune_;
   ros::Publisher voxel_pub_;
+  ros::WallTime last_voxel_cloud_;
   std::vector<std::uint8_t> projection_;
   std::size_t lethal_columns_ = 0;
   std::size_t dropped_updates_ = 0;
