@@ -50,11 +50,12 @@ def voxel_markdown(rows: list[dict[str, float]]) -> list[str]:
         "exact 3-D traversal of every ray (each voxel a ray crosses visited once). Goal: <= 3 ms "
         "per frame on one core, with clearing.",
         "",
-        "| pixels used | clearing | rays | voxel visits | ms / frame (p90) | of it rays ms | "
-        "projection ms | blocks | memory |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| pixels used | clearing | one ray per end voxel | rays | voxel visits | ms / frame (p90) "
+        "| of it rays ms | projection ms | blocks | memory |",
+        "|---|---|---|---|---|---|---|---|---|---|",
         *(
-            f"| every {int(r['stride'])} | {'yes' if r['clearing'] else 'no'} | {int(r['rays'])} | "
+            f"| every {int(r['stride'])} | {'yes' if r['clearing'] else 'no'} | "
+            f"{'yes' if r.get('one_ray_per_end_voxel') else 'no'} | {int(r['rays'])} | "
             f"{int(r['voxels_walked'])} | {r['frame_median_ms']:.1f} ({r['frame_p90_ms']:.1f}) | "
             f"{r['rays_median_ms']:.2f} | {r['project_median_ms']:.2f} | {int(r['blocks'])} | "
             f"{r['memory_bytes'] / 1e6:.2f} MB |"

@@ -523,7 +523,7 @@ void runStaticMap(int iters) {
 // a 0.5 m box 2 m ahead, a table top (0.75 m) 1.5 m ahead on the left; depths beyond 4.5 m are
 // no-returns. A freshly noised frame (1 cm) every iteration. Timed: rays (back-projection) and
 // integration separately, and the column projection of the whole window.
-void runVoxel(int iters, int stride, bool clearing) {
+void runVoxel(int iters, int stride, bool clearing, bool one_ray_per_end_voxel = false) {
   PinholeCamera cam;
   cam.width = 640;
   cam.height = 480;
@@ -583,6 +583,7 @@ void runVoxel(int iters, int stride, bool clearing) {
   rays.raytrace_max_range_m = 4.0;
   rays.no_return_range_m = 4.0;
   rays.clearing = clearing;
+  rays.one_ray_per_end_voxel = one_ray_per_end_voxel;
   DepthRays out;
   std::vector<double> ray_ms, integrate_ms, project_ms;
   std::vector<std::uint8_t> costs;
@@ -606,21 +607,24 @@ void runVoxel(int iters, int stride, bool clearing) {
       std::count(costs.begin(), costs.end(), static_cast<std::uint8_t>(254)));
   std::printf(
       "{\"bench\": \"voxel_depth\", \"width\": 640, \"height\": 480, \"stride\": %d, "
-      "\"clearing\": %s, \"voxel_m\": 0.05, \"range_m\": 4.0, \"iters\": %d, \"rays\": %zu, "
+      "\"clearing\": %s, \"one_ray_per_end_voxel\": %s, \"voxel_m\": 0.05, \"range_m\": 4.0, "
+      "\"iters\": %d, \"rays\": %zu, "
       "\"voxels_walked\": %zu, \"marked\": %zu, \"cleared\": %zu, \"frame_median_ms\": %.3f, "
       "\"frame_p90_ms\": %.3f, \"rays_median_ms\": %.3f, \"integrate_median_ms\": %.3f, "
       "\"project_median_ms\": %.3f, \"blocks\": %zu, \"memory_bytes\": %zu, \"lethal_columns\": "
       "%zu}\n",
-      stride, clearing ? "true" : "false", iters, last.rays, last.voxels_walked, last.marked,
-      last.cleared, medianOf(total), p90Of(total), medianOf(ray_ms), medianOf(integrate_ms),
-      medianOf(project_ms), map.blocks(), map.memoryBytes(), lethal);
+      stride, clearing ? "true" : "false", one_ray_per_end_voxel ? "true" : "false", iters,
+      last.rays, last.voxels_walked, last.marked, last.cleared, medianOf(total), p90Of(total),
+      medianOf(ray_ms), medianOf(integrate_ms), medianOf(project_ms), map.blocks(),
+      map.memoryBytes(), lethal);
 }
 
 void runVoxelRows(int iters) {
   const int n = std::max(10, iters / 10);
-  runVoxel(n, 1, true);   // every pixel, marking and clearing: the goal (<= 3 ms)
-  runVoxel(n, 1, false);  // marking only: what the clearing costs
-  runVoxel(n, 2, true);   // every 2nd pixel in x and y
+  runVoxel(n, 1, true);        // every pixel, marking and clearing: the goal (<= 3 ms)
+  runVoxel(n, 1, false);       // marking only: what the clearing costs
+  runVoxel(n, 2, true);        // every 2nd pixel in x and y
+  runVoxel(n, 1, true, true);  // every pixel, one ray per end voxel
 }
 
 }  // namespace

@@ -118,6 +118,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   reader.get("no_return_range", &s->rays.no_return_range_m);
   reader.get("camera_info_topic", &s->camera_info_topic);
   reader.get("zero_is_no_return", &s->zero_is_no_return);
+  reader.get("one_ray_per_end_voxel", &s->rays.one_ray_per_end_voxel);
   reader.get("stride", &s->stride);
   reader.get("tf_queue_size", &s->tf_queue_size);
   reader.unsupported("min_obstacle_height",

@@ -101,6 +101,8 @@ void bindVoxel(py::module& m) {
       .def_readwrite("no_return_range_m", &VoxelRayConfig::no_return_range_m)
       .def_readwrite("marking", &VoxelRayConfig::marking)
       .def_readwrite("clearing", &VoxelRayConfig::clearing)
+      .def_readwrite("one_ray_per_end_voxel", &VoxelRayConfig::one_ray_per_end_voxel,
+                     "cast only the first ray of a frame ending in each voxel")
       .def("validate", &VoxelRayConfig::validate, "Empty string if valid, else the reason.");
 
   py::class_<VoxelMap>(m, "VoxelMap", "Sparse 3-D log-odds voxels over a rolling window.")

@@ -1845,6 +1845,7 @@ def voxel_ray_config_args(g: Gen) -> dict[str, Any]:
         "no_return_range_m": g.f(0.0, 6.0, 0.1),
         "marking": g.b() or g.b(),
         "clearing": g.b() or g.b(),
+        "one_ray_per_end_voxel": g.b(),
     }
 
 

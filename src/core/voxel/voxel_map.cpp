@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -229,7 +230,11 @@ void VoxelMap::update(int x, int y, int z, float delta, float stamp, VoxelIntegr
     ++stats->dropped_updates;
     return;
   }
-  const int v = voxelIndex(x + x0_, y + y0_, z);
+  updateVoxel(b, voxelIndex(x + x0_, y + y0_, z), x, y, delta, stamp, stats);
+}
+
+void VoxelMap::updateVoxel(VoxelBlock* b, int v, int x, int y, float delta, float stamp,
+                           VoxelIntegrationStats* stats) {
   if (b->frame[v] == frame_) return;  // updated by this frame already (hits first)
   b->frame[v] = frame_;
   double l = b->log_odds[v];
@@ -249,20 +254,57 @@ void VoxelMap::update(int x, int y, int z, float delta, float stamp, VoxelIntegr
 }
 
 void VoxelMap::clearRay(const double p0[3], const double p1[3], bool include_end, float stamp,
-                        VoxelIntegrationStats* stats) {
+                        bool one_per_end_voxel, VoxelIntegrationStats* stats) {
   const VoxelBox box{nx_, ny_, config_.z_voxels};
+  // one_per_end_voxel: false if a ray of this frame ended in voxel e already (else claims it).
+  const auto first_to_end_in = [this](int ex, int ey, int ez) {
+    VoxelBlock* b = ensureBlock(ex, ey, ez);
+    if (b == nullptr) return true;  // no room to remember it: cast the ray
+    const int v = voxelIndex(ex + x0_, ey + y0_, ez);
+    if (b->ray_frame[v] == frame_) return false;
+    b->ray_frame[v] = frame_;
+    return true;
+  };
+  const bool end_inside = p1[0] >= 0.0 && p1[1] >= 0.0 && p1[2] >= 0.0 && p1[0] < nx_ &&
+                          p1[1] < ny_ && p1[2] < config_.z_voxels;
+  if (one_per_end_voxel && end_inside) {
+    // Decided before the clip (most rays of a depth image are repeats): the end voxel is the one
+    // the walk ends in, the same rounding.
+    const auto cell = [p1](int a, int n) {
+      return static_cast<int>(FixedSegment::toFixed(p1[a], n) >> FixedSegment::kShift);
+    };
+    if (!first_to_end_in(cell(0, nx_), cell(1, ny_), cell(2, config_.z_voxels))) return;
+  }
   FixedSegment s;
   bool end_clipped = false;
   if (!clipToFixed(box, p0, p1, &s, &end_clipped)) return;
-  const int n = VoxelWalk(s).walk(include_end || end_clipped, [&](int x, int y, int z) {
-    VoxelBlock* b = ensureBlock(x, y, z);
-    if (b == nullptr) {
+  const VoxelWalk walk(s);
+  if (one_per_end_voxel && !end_inside) {
+    const auto e = walk.end();
+    if (!first_to_end_in(e[0], e[1], e[2])) return;
+  }
+  // Consecutive voxels of a ray mostly share a block: its pointer is looked up once per block.
+  VoxelBlock* block = nullptr;
+  int cached_key[3] = {std::numeric_limits<int>::min(), 0, 0};
+  const int x0 = x0_;
+  const int y0 = y0_;
+  const std::uint32_t frame = frame_;
+  const int n = walk.walk(include_end || end_clipped, [&](int x, int y, int z) {
+    const int gx = x + x0;
+    const int gy = y + y0;
+    const int key[3] = {gx >> VoxelBlock::kEdgeShift, gy >> VoxelBlock::kEdgeShift,
+                        z >> VoxelBlock::kEdgeShift};
+    if (key[0] != cached_key[0] || key[1] != cached_key[1] || key[2] != cached_key[2]) {
+      block = ensureBlock(x, y, z);
+      std::copy(key, key + 3, cached_key);
+    }
+    if (block == nullptr) {
       ++stats->dropped_updates;
       return;
     }
-    const int v = voxelIndex(x + x0_, y + y0_, z);
-    if (b->frame[v] == frame_) return;  // fast path of update(): most visits end here
-    update(x, y, z, miss_, stamp, stats);
+    const int v = voxelIndex(gx, gy, z);
+    if (block->frame[v] == frame) return;  // the common case: updated by this frame already
+    updateVoxel(block, v, x, y, miss_, stamp, stats);
   });
   stats->voxels_walked += static_cast<std::size_t>(n);
 }
@@ -289,7 +331,9 @@ VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const f
   if (++frame_ == 0) {
     // 2^32 frames: reset the tags so that no voxel looks updated by the new frame already.
     for (auto& b : table_) {
-      if (b) std::fill(std::begin(b->frame), std::end(b->frame), 0u);
+      if (!b) continue;
+      std::fill(std::begin(b->frame), std::end(b->frame), 0u);
+      std::fill(std::begin(b->ray_frame), std::end(b->ray_frame), 0u);
     }
     frame_ = 1;
   }
@@ -343,7 +387,7 @@ VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const f
         dist <= rays.raytrace_max_range_m ? p : origin + d * (rays.raytrace_max_range_m / dist);
     double u[3];
     units(end, u);
-    clearRay(o_units, u, false, stamp, &stats);
+    clearRay(o_units, u, false, stamp, rays.one_ray_per_end_voxel, &stats);
   }
   for (std::size_t i = 0; i < n_no_returns; ++i) {
     const Eigen::Vector3d d = point(no_returns, i) - origin;
@@ -355,7 +399,7 @@ VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const f
     if (!rays.clearing || rays.no_return_range_m <= 0.0) continue;
     double u[3];
     units(origin + d * (rays.no_return_range_m / dist), u);
-    clearRay(o_units, u, true, stamp, &stats);
+    clearRay(o_units, u, true, stamp, rays.one_ray_per_end_voxel, &stats);
   }
   return stats;
 }

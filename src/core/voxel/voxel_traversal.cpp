@@ -73,25 +73,14 @@ bool clipToFixed(const VoxelBox& box, const double p0[3], const double p1[3], Fi
 
 VoxelWalk::VoxelWalk(const FixedSegment& s) {
   constexpr std::int64_t kOne = FixedSegment::kOne;
-  std::int64_t ad[3];
   for (int a = 0; a < 3; ++a) {
-    ad[a] = s.p1[a] >= s.p0[a] ? s.p1[a] - s.p0[a] : s.p0[a] - s.p1[a];
+    ad_[a] = s.p1[a] >= s.p0[a] ? s.p1[a] - s.p0[a] : s.p0[a] - s.p1[a];
     start_[a] = static_cast<int>(s.p0[a] >> FixedSegment::kShift);
     const int end = static_cast<int>(s.p1[a] >> FixedSegment::kShift);
     step_[a] = s.p1[a] > s.p0[a] ? 1 : -1;
     steps_[a] = std::abs(end - start_[a]);
-  }
-  for (int a = 0; a < 3; ++a) {
-    if (ad[a] == 0) continue;  // never crosses a face of this axis (steps_[a] == 0)
-    // The product of the other axes' non-zero extents: T_a = N_a * P / d_a.
-    Int128 scale = 1;
-    for (int b = 0; b < 3; ++b) {
-      if (b != a && ad[b] != 0) scale *= ad[b];
-    }
-    const std::int64_t first = step_[a] > 0 ? (std::int64_t{start_[a]} + 1) * kOne - s.p0[a]
-                                            : s.p0[a] - std::int64_t{start_[a]} * kOne;
-    t_next_[a] = static_cast<Int128>(first) * scale;
-    t_delta_[a] = static_cast<Int128>(kOne) * scale;
+    first_[a] = step_[a] > 0 ? (std::int64_t{start_[a]} + 1) * kOne - s.p0[a]
+                             : s.p0[a] - std::int64_t{start_[a]} * kOne;
   }
 }
 

@@ -96,6 +96,24 @@ TEST(VoxelMap, EachVoxelOnceAFrameHitsFirst) {
   EXPECT_EQ(s.cleared, 29u);  // voxels 0..29 without 10
   EXPECT_NEAR(map.logOdds(10, 5, 5, 0.0), kHit, 1e-6);
   EXPECT_NEAR(map.logOdds(5, 5, 5, 0.0), kMiss, 1e-6);
+  // Every ray walked: 40 x 30 voxels (0..29) + 10 (0..9).
+  EXPECT_EQ(s.voxels_walked, 40u * 30u + 10u);
+}
+
+TEST(VoxelMap, OneRayPerEndVoxel) {
+  VoxelMap map(roomConfig(), 0.0, 0.0, 40, 40);
+  std::vector<float> pts;
+  for (int k = 0; k < 40; ++k) add(&pts, 3.05 + 0.001 * k, 0.55, 0.55);  // all in voxel 30
+  add(&pts, 1.05, 0.55, 0.55);
+  VoxelRayConfig r = longRays();
+  r.one_ray_per_end_voxel = true;
+  const auto s = integrate(&map, Eigen::Vector3d(0.05, 0.55, 0.55), pts, 0.0, r);
+  // One ray to voxel 30 (30 visits) and the one to voxel 10 (10): the same marks and misses.
+  EXPECT_EQ(s.voxels_walked, 40u);
+  EXPECT_EQ(s.marked, 2u);
+  EXPECT_EQ(s.cleared, 29u);
+  // The next frame casts again.
+  EXPECT_EQ(integrate(&map, Eigen::Vector3d(0.05, 0.55, 0.55), pts, 1.0, r).voxels_walked, 40u);
 }
 
 TEST(VoxelMap, ColumnRuleFollowsCostmap2d) {
@@ -259,7 +277,8 @@ TEST(VoxelMap, MemoryBoundDropsAndCounts) {
   VoxelMapConfig c = roomConfig();
   c.max_memory_mib = 0.01;  // 10485 bytes: a table of 5 x 5 x 3 pointers (600) and one block
   VoxelMap map(c, 0.0, 0.0, 40, 40);
-  EXPECT_EQ(map.maxBlocks(), 1u);  // (10485 - 600) / 6144 = 1.6
+  EXPECT_EQ(sizeof(VoxelBlock), 512u * 16u);
+  EXPECT_EQ(map.maxBlocks(), 1u);  // (10485 - 600) / 8192 = 1.2
   std::vector<float> pts;
   add(&pts, 0.35, 0.35, 0.35);  // block (0, 0, 0)
   add(&pts, 2.05, 2.05, 0.35);  // block (2, 2, 0)

@@ -58,6 +58,12 @@ struct VoxelRayConfig {
   double no_return_range_m = 3.0;     ///< a no-return ray clears this far, m
   bool marking = true;
   bool clearing = true;
+  /// Of the rays of a frame that end in the same voxel, cast only the first (every return still
+  /// marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside
+  /// the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not
+  /// cleared in that frame. Trades that for far fewer rays: a 640x480 depth image has ~40 pixels
+  /// per 5 cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour).
+  bool one_ray_per_end_voxel = false;
 
   std::string validate() const;
 };

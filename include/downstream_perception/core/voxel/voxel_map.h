@@ -35,8 +35,9 @@ struct VoxelBlock {
   static constexpr int kEdge = 1 << kEdgeShift;
   static constexpr int kVoxels = kEdge * kEdge * kEdge;
   float log_odds[kVoxels] = {};
-  float stamp_s[kVoxels] = {};        ///< last update, s since the map's epoch
-  std::uint32_t frame[kVoxels] = {};  ///< integrate() call of the last update (0 = never)
+  float stamp_s[kVoxels] = {};            ///< last update, s since the map's epoch
+  std::uint32_t frame[kVoxels] = {};      ///< integrate() call of the last update (0 = never)
+  std::uint32_t ray_frame[kVoxels] = {};  ///< integrate() call of the last ray ending here
 };
 
 enum class VoxelState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 1 };
@@ -135,8 +136,10 @@ class VoxelMap {
   }
   void rebuildTable(int x0, int y0, int nx, int ny);
   void update(int x, int y, int z, float delta, float stamp, VoxelIntegrationStats* stats);
+  void updateVoxel(VoxelBlock* b, int v, int x, int y, float delta, float stamp,
+                   VoxelIntegrationStats* stats);
   void clearRay(const double p0[3], const double p1[3], bool include_end, float stamp,
-                VoxelIntegrationStats* stats);
+                bool one_per_end_voxel, VoxelIntegrationStats* stats);
 
   VoxelMapConfig config_;
   double anchor_x_ = 0.0;

@@ -12,11 +12,10 @@
 //
 // Exactness: the end points are first rounded to 2^-20 voxel (fixed point, int64); everything
 // after that is integer arithmetic. Which face is crossed next compares the crossing parameters
-// t_a = N_a / d_a of the three axes; scaled by the product P of the non-zero |d_a| they become the
-// integers T_a = N_a * P / d_a (__int128: the box is at most 2^16 voxels per axis, so N_a < 2^36,
-// P < 2^108 and T_a < 2^108), and ties (the segment through an edge or a corner) are exact
-// equalities, crossed in one diagonal step. No epsilon anywhere: lattice-exact rays (simulated
-// walls, tests) are walked exactly like measured ones.
+// t_a = N_a / d_a of the three axes through their pairwise differences scaled to integers (see
+// VoxelWalk::walkWith), and ties (the segment through an edge or a corner) are exact equalities,
+// crossed in one diagonal step. No epsilon anywhere: lattice-exact rays (simulated walls, tests)
+// are walked exactly like measured ones.
 #pragma once
 
 #include <array>
@@ -83,44 +82,73 @@ class VoxelWalk {
   /// include_end. Returns the number of visits.
   template <class Visitor>
   int walk(bool include_end, Visitor&& visit) const {
-    int c[3] = {start_[0], start_[1], start_[2]};
-    int left[3] = {steps_[0], steps_[1], steps_[2]};
-    Int128 t[3] = {t_next_[0], t_next_[1], t_next_[2]};
+    // Rays shorter than 2^30 / 2^20 = 1024 voxels per axis (all sensor rays) in int64, longer
+    // ones in __int128: the same arithmetic, the bound is the pairwise terms' magnitude.
+    constexpr std::int64_t kShortRay = std::int64_t{1} << 30;
+    if (ad_[0] < kShortRay && ad_[1] < kShortRay && ad_[2] < kShortRay) {
+      return walkWith<std::int64_t>(include_end, visit);
+    }
+    return walkWith<Int128>(include_end, visit);
+  }
+
+ private:
+  // Which face is crossed next compares the crossing parameters t_a = N_a / d_a (N_a: fixed-point
+  // distance along axis a to its next face, d_a: the axis' extent). Their pairwise differences,
+  // scaled by d_a * d_b, are kept as integers: e_xy = N_x d_y - N_y d_x (< 0: x first, 0: a tie,
+  // an edge crossed diagonally), e_xz, e_yz; a step in x adds kOne * d_y to e_xy, and so on.
+  // |e| < (d + 2 kOne) * d: below 2^61 for d < 2^30, below 2^108 in __int128 otherwise.
+  template <class I, class Visitor>
+  int walkWith(bool include_end, Visitor& visit) const {
+    constexpr I kOne = FixedSegment::kOne;
+    const I ax = ad_[0], ay = ad_[1], az = ad_[2];
+    const I fx = first_[0], fy = first_[1], fz = first_[2];
+    I exy = fx * ay - fy * ax;
+    I exz = fx * az - fz * ax;
+    I eyz = fy * az - fz * ay;
+    const I kx = kOne * ax, ky = kOne * ay, kz = kOne * az;
+    int x = start_[0], y = start_[1], z = start_[2];
+    int lx = steps_[0], ly = steps_[1], lz = steps_[2];
     int visits = 0;
-    while (left[0] + left[1] + left[2] > 0) {
-      visit(c[0], c[1], c[2]);
+    while (lx + ly + lz > 0) {
+      visit(x, y, z);
       ++visits;
-      // The earliest next crossing among the axes that still cross a face before the end (an
-      // axis with no steps left crosses at t >= 1 only, never before those that do).
-      Int128 tmin = 0;
-      bool any = false;
-      for (int a = 0; a < 3; ++a) {
-        if (left[a] > 0 && (!any || t[a] < tmin)) {
-          tmin = t[a];
-          any = true;
-        }
+      // Only axes that still cross a face before the end compete (an axis with no steps left
+      // crosses at t >= 1, never before those that do); every earliest one steps.
+      const bool cx = lx > 0, cy = ly > 0, cz = lz > 0;
+      const bool mx = cx && (!cy || exy <= 0) && (!cz || exz <= 0);
+      const bool my = cy && (!cx || exy >= 0) && (!cz || eyz <= 0);
+      const bool mz = cz && (!cx || exz >= 0) && (!cy || eyz >= 0);
+      if (mx) {
+        x += step_[0];
+        --lx;
+        exy += ky;
+        exz += kz;
       }
-      for (int a = 0; a < 3; ++a) {
-        if (left[a] > 0 && t[a] == tmin) {  // ties: an edge or a corner, one diagonal step
-          c[a] += step_[a];
-          t[a] += t_delta_[a];
-          --left[a];
-        }
+      if (my) {
+        y += step_[1];
+        --ly;
+        exy -= kx;
+        eyz += kz;
+      }
+      if (mz) {
+        z += step_[2];
+        --lz;
+        exz -= kx;
+        eyz -= ky;
       }
     }
     if (include_end) {
-      visit(c[0], c[1], c[2]);
+      visit(x, y, z);
       ++visits;
     }
     return visits;
   }
 
- private:
   std::array<int, 3> start_{};
   std::array<int, 3> step_{};
   std::array<int, 3> steps_{};
-  std::array<Int128, 3> t_next_{};
-  std::array<Int128, 3> t_delta_{};
+  std::array<std::int64_t, 3> ad_{};     ///< |p1 - p0| per axis, fixed point
+  std::array<std::int64_t, 3> first_{};  ///< fixed-point distance to the first face per axis
 };
 
 /// Convenience form (tests, Python): the voxels of the segment p0-p1 (voxel units, box-relative),
