@@ -11,6 +11,7 @@ void bindGrid(py::module& m);      // bind_grid.cpp
 void bindCostmap(py::module& m);   // bind_costmap.cpp
 void bindTracking(py::module& m);  // bind_tracking.cpp
 void bindHandoff(py::module& m);   // bind_handoff.cpp
+void bindVoxel(py::module& m);     // bind_voxel.cpp (after Tsdf's PinholeCamera, LogOddsConfig)
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "downstream_perception ROS-free core (C++), with numpy arrays in and out.";
@@ -22,4 +23,5 @@ PYBIND11_MODULE(_core, m) {
   bindCostmap(m);
   bindTracking(m);
   bindHandoff(m);
+  bindVoxel(m);
 }

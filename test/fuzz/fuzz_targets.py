@@ -1819,6 +1819,176 @@ def call_msg_depth(a: dict[str, Any]) -> Any:
     return ask_driver("depth", msg)
 
 
+# ----------------------------------------------------------------------------- 3-D voxel map
+WINDOW_NASTY = (0, -1, 65537, 2**31, -(2**31))  # invalid sides only: a valid huge one is slow
+
+
+def voxel_config_args(g: Gen) -> dict[str, Any]:
+    return {
+        "resolution_m": g.f(0.02, 0.2, 0.05),
+        "z_resolution_m": g.f(0.02, 0.3, 0.05),
+        "origin_z_m": g.f(-0.5, 0.5, 0.05),
+        "z_voxels": g.i(1, 40, 0.05, (0, -1, 1024, 1025, 2**31 - 1, -(2**31))),
+        "mark_threshold": g.i(0, 3, 0.05, INT32_NASTY),
+        "unknown_threshold": g.i(0, 20, 0.05, INT32_NASTY),
+        "min_obstacle_height_m": g.f(0.0, 0.3, 0.05),
+        "max_obstacle_height_m": g.f(0.5, 2.0, 0.05),
+        "decay_time_s": g.f(0.0, 5.0, 0.05) if g.b() else 0.0,
+        "max_memory_mib": g.f(0.01, 8.0, 0.05),
+    }
+
+
+def voxel_ray_config_args(g: Gen) -> dict[str, Any]:
+    return {
+        "obstacle_max_range_m": g.f(0.5, 5.0, 0.1),
+        "raytrace_max_range_m": g.f(0.5, 6.0, 0.1),
+        "no_return_range_m": g.f(0.0, 6.0, 0.1),
+        "marking": g.b() or g.b(),
+        "clearing": g.b() or g.b(),
+        "one_ray_per_end_voxel": g.b(),
+    }
+
+
+def gen_voxel_map(rng: np.random.Generator) -> dict[str, Any]:
+    g = Gen(rng, 0.2)
+    ops: list[tuple[Any, ...]] = []
+    for _ in range(int(rng.integers(1, 7))):
+        op = g.pick(("points", "points", "depth", "window", "prune", "clear"))
+        if op == "points":
+            n, m = int(g.pick((0, 1, 40))), int(g.pick((0, 1, 10)))
+            ops.append(
+                (
+                    op,
+                    g.array((3,), -1, 1),
+                    g.array((n, 3), -2, 4),
+                    g.array((m, 3), -2, 4),
+                    g.f(0, 10, 0.1),
+                    voxel_ray_config_args(g),
+                )
+            )
+        elif op == "depth":
+            cam = camera_args(g)
+            ops.append(
+                (op, depth_args(g, cam["shape"]), cam, pose_matrix(g), g.f(0, 10, 0.1))
+                + (voxel_ray_config_args(g), g.b(), g.i(1, 3, 0.1, INT32_NASTY))
+            )
+        elif op == "window":
+            ops.append(
+                (op, *(g.i(-50, 50, 0.1, INT32_NASTY) for _ in range(2)))
+                + tuple(g.i(1, 120, 0.1, WINDOW_NASTY) for _ in range(2))
+            )
+        else:
+            ops.append((op, g.f(0, 20, 0.1)))
+    return {
+        "config": voxel_config_args(g),
+        "anchor": (g.f(-3, 0, 0.08), g.f(-3, 0, 0.08)),
+        "size": (g.i(1, 120, 0.08, WINDOW_NASTY), g.i(1, 120, 0.08, WINDOW_NASTY)),
+        "ops": ops,
+        "now": g.f(0, 20, 0.1),
+    }
+
+
+def make_voxel_config(a: dict[str, Any]) -> Any:
+    return configure(core().VoxelMapConfig(), a)
+
+
+def call_voxel_map(a: dict[str, Any]) -> Any:
+    c = core()
+    config = make_voxel_config(a["config"])
+    valid = config.validate()
+    try:
+        vmap = c.VoxelMap(config, a["anchor"][0], a["anchor"][1], *a["size"])
+    except (ValueError, TypeError) as error:
+        if not str(error):
+            raise
+        return {"skipped": True, "valid": valid}
+    problems: list[str] = []
+    moved = False
+    for op in a["ops"]:
+        try:
+            if op[0] == "points":
+                rays = configure(c.VoxelRayConfig(), op[5])
+                s = vmap.integrate(op[1], op[2], op[3], op[4], rays)
+                if s["marked"] + s["cleared"] > s["voxels_walked"] + s["rays"]:
+                    problems.append(f"more updates than visits: {s}")
+            elif op[0] == "depth":
+                rays = configure(c.VoxelRayConfig(), op[5])
+                vmap.integrate_depth(op[1], make_camera(op[2]), op[3], op[4], rays, op[6], op[7])
+            elif op[0] == "window":
+                vmap.set_window(*op[1:])
+                moved = True
+            elif op[0] == "prune":
+                vmap.prune(op[1])
+            else:
+                vmap.clear()
+        except (ValueError, TypeError, IndexError) as error:
+            if not str(error):
+                raise
+        if not moved and vmap.blocks > vmap.max_blocks:
+            problems.append(f"{vmap.blocks} blocks with max_blocks {vmap.max_blocks}")
+    return {
+        "valid": valid,
+        "problems": problems,
+        "shape": vmap.shape,
+        "origin": vmap.window_origin,
+        "costs": vmap.project(a["now"]),
+        "occupied": vmap.occupied_centres(a["now"]),
+        "config": vmap.config,
+    }
+
+
+def garbage_voxel_map(a: dict[str, Any], r: Any) -> str | None:
+    if r.get("skipped"):
+        return None
+    if r["valid"]:
+        return f"VoxelMap accepted an invalid config ({r['valid']})"
+    if r["problems"]:
+        return r["problems"][0]
+    nx, ny, nz = r["shape"]
+    costs = r["costs"]
+    if costs.shape != (ny, nx) or not np.isin(costs, (0, 254, 255)).all():
+        return f"project gave shape {costs.shape} or values {np.unique(costs)[:5]}"
+    occ = np.asarray(r["occupied"], dtype=float)
+    if occ.size:
+        cfg = r["config"]
+        lo = np.array([r["origin"][0], r["origin"][1], cfg.origin_z_m])
+        hi = lo + np.array([nx * cfg.resolution_m, ny * cfg.resolution_m, nz * cfg.z_resolution_m])
+        slack = 1e-3 * np.maximum(1.0, np.abs(hi))
+        if not np.isfinite(occ).all() or ((occ < lo - slack) | (occ > hi + slack)).any():
+            return "an occupied voxel centre outside the window or not finite"
+    return None
+
+
+def gen_voxel_ray(rng: np.random.Generator) -> dict[str, Any]:
+    g = Gen(rng, 0.2)
+    box = [g.i(1, 30, 0.15, WINDOW_NASTY) for _ in range(3)]
+    if g.chance(0.2):
+        box = g.array((3,), 1, 30)
+    return {
+        "box": box,
+        "p0": g.array((3,), -5, 35),
+        "p1": g.array((3,), -5, 35),
+        "include_end": g.b(),
+    }
+
+
+def call_voxel_ray(a: dict[str, Any]) -> Any:
+    return core().voxel_ray(a["box"], a["p0"], a["p1"], a["include_end"])
+
+
+def garbage_voxel_ray(a: dict[str, Any], cells: Any) -> str | None:
+    box = np.asarray(a["box"]).astype(np.int64)
+    if cells.size == 0:
+        return None
+    if (cells < 0).any() or (cells >= box).any():
+        return f"voxel {cells[((cells < 0) | (cells >= box)).any(axis=1)][0]} outside {box}"
+    if len({tuple(c) for c in cells.tolist()}) != len(cells):
+        return "a voxel visited twice"
+    if (np.abs(np.diff(cells, axis=0)) > 1).any():
+        return "consecutive voxels more than one step apart"
+    return None
+
+
 # ----------------------------------------------------------------------------- the list
 def binding_targets() -> list[Target]:
     return [
@@ -1995,6 +2165,14 @@ def binding_targets() -> list[Target]:
             garbage_slice_distance,
             ("slice_distance",),
         ),
+        Target(
+            "VoxelMap",
+            gen_voxel_map,
+            call_voxel_map,
+            garbage_voxel_map,
+            ("VoxelMap", "VoxelMapConfig", "VoxelRayConfig", "PinholeCamera"),
+        ),
+        Target("voxel_ray", gen_voxel_ray, call_voxel_ray, garbage_voxel_ray, ("voxel_ray",)),
     ]
 
 

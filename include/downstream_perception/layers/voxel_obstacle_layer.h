@@ -1,0 +1,103 @@
+// downstream_perception/VoxelObstacleLayer: a 3-D voxel obstacle layer with costmap_2d
+// VoxelLayer's keys and meaning. PointCloud2 and depth-image sources, each transformed at its own
+// stamp (tf2 MessageFilter), mark and clear a sparse 3-D log-odds voxel map (core/voxel) over the
+// costmap's window with exact 3-D ray traversal: a ray that passes under a table top does not
+// erase it. Each column within the robot's height band is projected into the master with
+// costmap_2d's rule (more than mark_threshold occupied voxels: lethal; at most unknown_threshold
+// unknown voxels: known, so free). The occupied voxels can be published as a PointCloud2.
+#pragma once
+
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/core/running_stats.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"
+#include "downstream_perception/core/voxel/voxel_map.h"
+#include "downstream_perception/ros/common/config_errors.h"
+#include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/costmap/layer.h"
+
+namespace downstream_perception {
+
+class VoxelObstacleLayer : public Layer {
+ public:
+  ~VoxelObstacleLayer() override;
+  void updateBounds(double robot_x, double robot_y, double robot_yaw, double* min_x, double* min_y,
+                    double* max_x, double* max_y) override;
+  void updateCosts(Costmap& master, int min_i, int min_j, int max_i, int max_j) override;
+  void matchSize() override;
+  void shiftOrigin(int dx, int dy) override;
+  void reset() override;
+  void activate() override;
+  void deactivate() override;
+  void onClockJump() override;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+
+ protected:
+  void onInitialize() override;
+
+ private:
+  /// One observation source (<layer ns>/<name>).
+  struct Source {
+    std::string name;
+    std::string topic;
+    std::string camera_info_topic;  ///< depth sources
+    std::string sensor_frame;       ///< overrides the message's frame_id when set
+    bool depth = false;             ///< DepthImage, else PointCloud2
+    bool zero_is_no_return = false;
+    int stride = 1;
+    int tf_queue_size = 20;
+    VoxelRayConfig rays;
+    FilteredSubscription<sensor_msgs::PointCloud2> cloud_sub;
+    FilteredSubscription<sensor_msgs::Image> depth_sub;
+    ros::Subscriber info_sub;
+    // Guarded by the layer's mutex_.
+    std::optional<PinholeCamera> camera;
+    std::size_t received = 0;
+    std::size_t integrated = 0;
+    std::size_t rejected = 0;
+    std::string last_rejection;
+    VoxelIntegrationStats last;
+    TimingStats integrate_ms;
+  };
+
+  void readSource(const std::string& name);
+  void onCloud(Source* s, const sensor_msgs::PointCloud2ConstPtr& msg);
+  void onDepth(Source* s, const sensor_msgs::ImageConstPtr& msg);
+  void onCameraInfo(Source* s, const sensor_msgs::CameraInfoConstPtr& msg);
+  void reject(Source* s, const std::string& why);
+  /// sensor -> global at the stamp; false (and a rejection) when tf cannot give it.
+  bool lookup(Source* s, const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
+  void integrate(Source* s, const Eigen::Vector3d& origin, const std::vector<float>& hits,
+                 const std::vector<float>& no_returns, const ros::Time& stamp);
+  void publishVoxels(const ros::Time& stamp);
+
+  std::mutex mutex_;
+  VoxelMapConfig config_;
+  std::unique_ptr<VoxelMap> map_;
+  std::vector<std::unique_ptr<Source>> sources_;
+  bool track_unknown_space_ = true;
+  int combination_method_ = 1;  ///< 0 overwrite, 1 maximum (costmap_2d's default)
+  bool publish_voxel_map_ = false;
+  bool redraw_all_ = true;  ///< the whole window changed (resize, shift, decay, reset)
+  CellBounds dirty_;        ///< window-relative columns changed since the last update
+  double prune_period_s_ = 1.0;
+  ros::Time last_prune_;
+  ros::Publisher voxel_pub_;
+  ros::WallTime last_voxel_cloud_;
+  std::vector<std::uint8_t> projection_;
+  std::size_t lethal_columns_ = 0;
+  std::size_t dropped_updates_ = 0;
+  ConfigErrorLog config_errors_;
+  std::vector<std::string> param_warnings_;
+};
+
+}  // namespace downstream_perception

@@ -1,0 +1,234 @@
+// Python bindings of the 3-D voxel obstacle map: VoxelMapConfig, VoxelRayConfig, VoxelMap and
+// voxel_ray, numpy arrays in and out. Registered after bindTsdf (PinholeCamera) and bindCostmap
+// (LogOddsConfig).
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+#include "downstream_perception/core/voxel/depth_rays.h"
+#include "downstream_perception/core/voxel/voxel_map.h"
+#include "downstream_perception/core/voxel/voxel_traversal.h"
+
+namespace py = pybind11;
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+
+using PointRows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+std::vector<float> toFloats(const PointRows& points) {
+  std::vector<float> out(static_cast<std::size_t>(points.size()));
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    for (int k = 0; k < 3; ++k) out[3 * i + k] = static_cast<float>(points(i, k));
+  }
+  return out;
+}
+
+Eigen::Isometry3d toIsometry(const Eigen::Matrix4d& m) {
+  if (!m.allFinite() || (m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9) {
+    throw std::invalid_argument("T_world_camera must be a finite 4 x 4 homogeneous transform");
+  }
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  if ((r * r.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
+    throw std::invalid_argument("T_world_camera's rotation is not orthonormal");
+  }
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = r;
+  t.translation() = m.topRightCorner<3, 1>();
+  return t;
+}
+
+py::dict statsToDict(const VoxelIntegrationStats& s) {
+  py::dict d;
+  d["rays"] = s.rays;
+  d["invalid_points"] = s.invalid_points;
+  d["marked"] = s.marked;
+  d["cleared"] = s.cleared;
+  d["voxels_walked"] = s.voxels_walked;
+  d["dropped_updates"] = s.dropped_updates;
+  d["touched"] = s.touched.empty() ? py::make_tuple()
+                                   : py::make_tuple(s.touched.min_x, s.touched.min_y,
+                                                    s.touched.max_x, s.touched.max_y);
+  return d;
+}
+
+py::array_t<std::int32_t> voxelsToArray(const std::vector<VoxelIndex>& v) {
+  py::array_t<std::int32_t> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+  auto a = out.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < static_cast<py::ssize_t>(v.size()); ++i) {
+    a(i, 0) = v[i].x;
+    a(i, 1) = v[i].y;
+    a(i, 2) = v[i].z;
+  }
+  return out;
+}
+
+void checkVoxel(const VoxelMap& m, int x, int y, int z) {
+  if (x < 0 || y < 0 || z < 0 || x >= m.nx() || y >= m.ny() || z >= m.nz()) {
+    throw py::index_error("voxel outside the window");
+  }
+}
+
+}  // namespace
+
+void bindVoxel(py::module& m) {
+  py::class_<VoxelMapConfig>(m, "VoxelMapConfig",
+                             "3-D voxel obstacle map settings (costmap_2d VoxelLayer's meaning).")
+      .def(py::init<>())
+      .def_readwrite("resolution_m", &VoxelMapConfig::resolution_m, "voxel edge in x, y (m)")
+      .def_readwrite("z_resolution_m", &VoxelMapConfig::z_resolution_m, "voxel height (m)")
+      .def_readwrite("origin_z_m", &VoxelMapConfig::origin_z_m, "bottom of voxel layer 0 (m)")
+      .def_readwrite("z_voxels", &VoxelMapConfig::z_voxels, "voxels per column")
+      .def_readwrite("mark_threshold", &VoxelMapConfig::mark_threshold,
+                     "a column with more occupied band voxels than this is lethal")
+      .def_readwrite("unknown_threshold", &VoxelMapConfig::unknown_threshold,
+                     "a column with at most this many unknown band voxels is known")
+      .def_readwrite("min_obstacle_height_m", &VoxelMapConfig::min_obstacle_height_m)
+      .def_readwrite("max_obstacle_height_m", &VoxelMapConfig::max_obstacle_height_m)
+      .def_readwrite("log_odds", &VoxelMapConfig::log_odds)
+      .def_readwrite("decay_time_s", &VoxelMapConfig::decay_time_s, "0 = no decay")
+      .def_readwrite("max_memory_mib", &VoxelMapConfig::max_memory_mib)
+      .def("validate", &VoxelMapConfig::validate, "Empty string if valid, else the reason.");
+
+  py::class_<VoxelRayConfig>(m, "VoxelRayConfig", "How far a source's rays mark and clear.")
+      .def(py::init<>())
+      .def_readwrite("obstacle_max_range_m", &VoxelRayConfig::obstacle_max_range_m)
+      .def_readwrite("raytrace_max_range_m", &VoxelRayConfig::raytrace_max_range_m)
+      .def_readwrite("no_return_range_m", &VoxelRayConfig::no_return_range_m)
+      .def_readwrite("marking", &VoxelRayConfig::marking)
+      .def_readwrite("clearing", &VoxelRayConfig::clearing)
+      .def_readwrite("one_ray_per_end_voxel", &VoxelRayConfig::one_ray_per_end_voxel,
+                     "cast only the first ray of a frame ending in each voxel")
+      .def("validate", &VoxelRayConfig::validate, "Empty string if valid, else the reason.");
+
+  py::class_<VoxelMap>(m, "VoxelMap", "Sparse 3-D log-odds voxels over a rolling window.")
+      .def(py::init<const VoxelMapConfig&, double, double, int, int>(), py::arg("config"),
+           py::arg("anchor_x_m"), py::arg("anchor_y_m"), py::arg("nx"), py::arg("ny"),
+           "Raises ValueError for an invalid config, anchor or window size.")
+      .def_property_readonly("config", &VoxelMap::config)
+      .def_property_readonly(
+          "shape", [](const VoxelMap& s) { return py::make_tuple(s.nx(), s.ny(), s.nz()); })
+      .def_property_readonly(
+          "window_offset",
+          [](const VoxelMap& s) { return py::make_tuple(s.windowX0(), s.windowY0()); })
+      .def_property_readonly(
+          "window_origin",
+          [](const VoxelMap& s) { return py::make_tuple(s.windowOriginX(), s.windowOriginY()); })
+      .def_property_readonly(
+          "band", [](const VoxelMap& s) { return py::make_tuple(s.bandFirst(), s.bandLast()); })
+      .def_property_readonly("blocks", &VoxelMap::blocks)
+      .def_property_readonly("max_blocks", &VoxelMap::maxBlocks)
+      .def_property_readonly("memory_bytes", &VoxelMap::memoryBytes)
+      .def("set_window", &VoxelMap::setWindow, py::arg("x0"), py::arg("y0"), py::arg("nx"),
+           py::arg("ny"))
+      .def(
+          "integrate",
+          [](VoxelMap& self, const Eigen::Vector3d& origin, const PointRows& hits,
+             const PointRows& no_returns, double stamp_s, const VoxelRayConfig& rays) {
+            const std::vector<float> h = toFloats(hits);
+            const std::vector<float> n = toFloats(no_returns);
+            VoxelIntegrationStats s;
+            {
+              py::gil_scoped_release release;
+              s = self.integrate(origin, h.data(), h.size() / 3, n.data(), n.size() / 3, stamp_s,
+                                 rays);
+            }
+            return statsToDict(s);
+          },
+          py::arg("origin"), py::arg("hits"), py::arg("no_returns"), py::arg("stamp_s"),
+          py::arg("rays"),
+          "One frame: hits (N x 3, world, m) mark and clear; no_returns (M x 3) give directions "
+          "that clear no_return_range_m. Returns the counts.")
+      .def(
+          "integrate_depth",
+          [](VoxelMap& self, py::array_t<float, py::array::c_style | py::array::forcecast> depth,
+             const PinholeCamera& camera, const Eigen::Matrix4d& T_world_camera, double stamp_s,
+             const VoxelRayConfig& rays, bool zero_is_no_return, int stride) {
+            const std::string why = camera.validate();
+            if (!why.empty()) throw std::invalid_argument("camera: " + why);
+            if (depth.ndim() != 2 || depth.shape(0) != camera.height ||
+                depth.shape(1) != camera.width) {
+              throw std::invalid_argument("depth must be (height, width)");
+            }
+            const Eigen::Isometry3d pose = toIsometry(T_world_camera);
+            VoxelIntegrationStats s;
+            DepthRays r;
+            {
+              py::gil_scoped_release release;
+              depthToRays(depth.data(), camera, pose, zero_is_no_return, stride, &r);
+              s = self.integrate(pose.translation(), r.hits.data(), r.hits.size() / 3,
+                                 r.no_returns.data(), r.no_returns.size() / 3, stamp_s, rays);
+            }
+            py::dict d = statsToDict(s);
+            d["invalid_pixels"] = r.invalid;
+            return d;
+          },
+          py::arg("depth"), py::arg("camera"), py::arg("T_world_camera"), py::arg("stamp_s"),
+          py::arg("rays"), py::arg("zero_is_no_return") = false, py::arg("stride") = 1,
+          "A depth image (metres, REP 118: +Inf = no return) as one frame.")
+      .def(
+          "log_odds",
+          [](const VoxelMap& self, int x, int y, int z, double now_s) {
+            checkVoxel(self, x, y, z);
+            return self.logOdds(x, y, z, now_s);
+          },
+          py::arg("x"), py::arg("y"), py::arg("z"), py::arg("now_s"))
+      .def(
+          "state",
+          [](const VoxelMap& self, int x, int y, int z, double now_s) {
+            checkVoxel(self, x, y, z);
+            return static_cast<int>(self.state(x, y, z, now_s));
+          },
+          py::arg("x"), py::arg("y"), py::arg("z"), py::arg("now_s"),
+          "-1 unknown, 0 free, 1 occupied.")
+      .def(
+          "column",
+          [](const VoxelMap& self, int x, int y, double now_s) {
+            checkVoxel(self, x, y, 0);
+            const VoxelColumn c = self.column(x, y, now_s);
+            return py::make_tuple(c.occupied, c.unknown, self.columnCost(c));
+          },
+          py::arg("x"), py::arg("y"), py::arg("now_s"),
+          "(occupied, unknown, cost) of a column within the height band.")
+      .def(
+          "project",
+          [](const VoxelMap& self, double now_s) {
+            std::vector<std::uint8_t> costs;
+            self.project(now_s, &costs);
+            py::array_t<std::uint8_t> out(
+                {static_cast<py::ssize_t>(self.ny()), static_cast<py::ssize_t>(self.nx())});
+            std::copy(costs.begin(), costs.end(), out.mutable_data());
+            return out;
+          },
+          py::arg("now_s"), "Column costs (ny, nx): 254 lethal, 0 free, 255 unknown.")
+      .def(
+          "occupied_centres",
+          [](const VoxelMap& self, double now_s) {
+            const auto c = self.occupiedCentres(now_s);
+            py::array_t<float> out({static_cast<py::ssize_t>(c.size()), py::ssize_t{3}});
+            auto a = out.mutable_unchecked<2>();
+            for (py::ssize_t i = 0; i < static_cast<py::ssize_t>(c.size()); ++i) {
+              for (int k = 0; k < 3; ++k) a(i, k) = c[i](k);
+            }
+            return out;
+          },
+          py::arg("now_s"), "Centres (N x 3, m) of the occupied voxels.")
+      .def("prune", &VoxelMap::prune, py::arg("now_s"))
+      .def("clear", &VoxelMap::clear);
+
+  m.def(
+      "voxel_ray",
+      [](const Eigen::Vector3i& box, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+         bool include_end) {
+        const double a[3] = {p0.x(), p0.y(), p0.z()};
+        const double b[3] = {p1.x(), p1.y(), p1.z()};
+        return voxelsToArray(voxelRay(VoxelBox{box.x(), box.y(), box.z()}, a, b, include_end));
+      },
+      py::arg("box"), py::arg("p0"), py::arg("p1"), py::arg("include_end") = true,
+      "The voxels (N x 3) of the segment p0-p1 (voxel units) in the box [0, nx) x [0, ny) x "
+      "[0, nz), in order, each once; empty when it misses the box or is not finite.");
+}

@@ -1,0 +1,105 @@
+"""pytest: the 3-D voxel obstacle map through Python: the exact traversal's hand-worked rays, a
+simulated depth camera under a table (the top stays lethal, the space under it is seen free),
+and refusals of invalid input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+dp = pytest.importorskip("downstream_perception._core", reason="compiled core not built")
+
+from downstream_perception.sim.depth_camera import Box, DepthCamera, Scene3D, look_at  # noqa: E402
+
+LETHAL, FREE, UNKNOWN = 254, 0, 255
+RES = 0.05
+
+
+def test_voxel_ray_hand_worked() -> None:
+    # The space diagonal through the corners (1,1,1) and (2,2,2): the three diagonal voxels only.
+    cells = dp.voxel_ray((10, 10, 10), (0.5, 0.5, 0.5), (2.5, 2.5, 2.5))
+    assert cells.tolist() == [[0, 0, 0], [1, 1, 1], [2, 2, 2]]
+    assert cells.dtype == np.int32
+    # Without the end voxel; a ray missing the box; a NaN end.
+    assert dp.voxel_ray((10, 10, 10), (0.5, 0.5, 0.5), (2.5, 0.5, 0.5), False).tolist() == [
+        [0, 0, 0],
+        [1, 0, 0],
+    ]
+    assert dp.voxel_ray((4, 4, 4), (-1, -1, 9), (9, 9, 9)).shape == (0, 3)
+    assert dp.voxel_ray((4, 4, 4), (1, 1, 1), (math.nan, 1, 1)).shape == (0, 3)
+
+
+def room_config() -> dp.VoxelMapConfig:
+    c = dp.VoxelMapConfig()
+    c.resolution_m = RES
+    c.z_resolution_m = RES
+    c.z_voxels = 40  # 0 .. 2 m
+    c.min_obstacle_height_m = 0.1
+    c.max_obstacle_height_m = 1.9
+    return c
+
+
+def rays() -> dp.VoxelRayConfig:
+    r = dp.VoxelRayConfig()
+    r.obstacle_max_range_m = 4.0
+    r.raytrace_max_range_m = 4.0
+    r.no_return_range_m = 4.0
+    return r
+
+
+def test_table_top_stays_lethal_while_the_floor_under_it_is_seen() -> None:
+    # A table top 0.8 x 0.8 m at 0.725 .. 0.775 m, centred at (0.8, 0); the room is 4 x 4 x 3 m.
+    scene = Scene3D(boxes=[Box((0.8, 0.0, 0.75), (0.4, 0.4, 0.025))])
+    cam = DepthCamera()
+    pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
+    vmap = dp.VoxelMap(room_config(), -2.0, -2.0, 80, 80)
+    # Once from a mast (1.8 m) looking down at the top, then 10 frames from 0.3 m under it.
+    mast = look_at(np.array([-0.6, 0.0, 1.8]), np.array([0.8, 0.0, 0.75]))
+    stats = vmap.integrate_depth(cam.render(scene, mast), pinhole, mast, 0.0, rays())
+    assert stats["marked"] > 0 and stats["cleared"] > 0 and stats["dropped_updates"] == 0
+    low = look_at(np.array([-0.6, 0.0, 0.3]), np.array([0.8, 0.0, 0.1]))
+    for k in range(1, 11):
+        vmap.integrate_depth(cam.render(scene, low), pinhole, low, float(k), rays())
+    costs = vmap.project(10.0)
+    assert costs.shape == (80, 80)
+    # Columns of the table's inner part (x 0.5 .. 1.1, y -0.3 .. 0.3): lethal.
+    inner = costs[(40 - 6) : (40 + 6), (40 + 10) : (40 + 22)]
+    assert (inner == LETHAL).all()
+    # Under the top's centre (x 0.80 .. 0.85, z 0.20 .. 0.25 m), on the low camera's way to the
+    # far wall's foot: free, while the top's voxel (z 0.75 .. 0.80, voxel 15) above it is occupied.
+    assert vmap.state(56, 40, 4, 10.0) == 0
+    assert vmap.state(56, 40, 15, 10.0) == 1
+    # The floor voxel itself is occupied in 3-D, below the band: no effect on the costmap.
+    assert vmap.band == (2, 37)
+    # In front of the table (x -0.2, y 0) the rays crossed the band: not lethal.
+    occupied, _, cost = vmap.column(36, 40, 10.0)
+    assert occupied == 0 and cost != LETHAL
+    # The voxel cloud: every occupied centre inside the window.
+    centres = vmap.occupied_centres(10.0)
+    assert centres.shape[1] == 3 and len(centres) > 100
+    assert (centres[:, :2] >= -2.0).all() and (centres[:, :2] <= 2.0).all()
+    assert vmap.memory_bytes >= vmap.blocks * 6144
+
+
+def test_invalid_input_is_refused() -> None:
+    c = room_config()
+    c.z_resolution_m = math.nan
+    assert "z_resolution_m" in c.validate()
+    with pytest.raises(ValueError, match="z_resolution_m"):
+        dp.VoxelMap(c, 0.0, 0.0, 10, 10)
+    with pytest.raises(ValueError, match="window"):
+        dp.VoxelMap(room_config(), 0.0, 0.0, 0, 10)
+    vmap = dp.VoxelMap(room_config(), 0.0, 0.0, 10, 10)
+    with pytest.raises(ValueError, match="origin"):
+        vmap.integrate((math.nan, 0, 0), np.zeros((0, 3)), np.zeros((0, 3)), 0.0, rays())
+    with pytest.raises(TypeError):
+        vmap.integrate((0, 0, 0), np.zeros((4, 2)), np.zeros((0, 3)), 0.0, rays())
+    hits = np.array([[math.nan, 0.2, 0.2], [0.3, 0.2, 0.2]])
+    s = vmap.integrate((0.05, 0.2, 0.2), hits, np.zeros((0, 3)), 0.0, rays())
+    assert s["invalid_points"] == 1 and s["marked"] == 1
+    # One hit: ln(0.7 / 0.3) = 0.8473.
+    assert vmap.log_odds(6, 4, 4, 0.0) == pytest.approx(math.log(7 / 3), abs=1e-6)
+    with pytest.raises(IndexError):
+        vmap.log_odds(10, 0, 0, 0.0)

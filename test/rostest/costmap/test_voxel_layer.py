@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""rostest: the VoxelObstacleLayer keeps a table top that rays pass under.
+
+The depth simulator's floating table top (0.72-0.76 m) must be lethal in the costmap, while the
+floor under it is seen (occupied floor voxels below the band, reached by rays passing under the
+top) and nothing between the floor and the top is occupied. The open floor is not lethal.
+"""
+
+from __future__ import annotations
+
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from sensor_msgs import point_cloud2
+from sensor_msgs.msg import PointCloud2
+from std_msgs.msg import Bool
+from tf2_ros import StaticTransformBroadcaster
+
+from downstream_perception.ros.costmap_client import CostmapClient
+from downstream_perception.ros.util import transform_stamped, wait_until
+from downstream_perception.sim.depth_camera import room_scene
+
+
+class VoxelLayerTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node("test_voxel_layer")
+        cls.static_tf = StaticTransformBroadcaster()
+        cls.static_tf.sendTransform(transform_stamped("odom", "base_link", rospy.Time.now(), y=1.5))
+        cls.done = False
+        cls.voxels: np.ndarray | None = None
+
+        def on_done(msg: Bool) -> None:
+            cls.done = cls.done or msg.data
+
+        def on_voxels(msg: PointCloud2) -> None:
+            pts = list(point_cloud2.read_points(msg, field_names=("x", "y", "z")))
+            cls.voxels = np.asarray(pts, dtype=float).reshape(-1, 3)
+
+        rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
+        rospy.Subscriber("/costmap/voxels/voxel_cloud", PointCloud2, on_voxels, queue_size=1)
+        cls.costmap = CostmapClient("/costmap/costmap")
+
+    def test_table_top_lethal_floor_under_it_seen(self) -> None:
+        self.assertTrue(wait_until(lambda: self.done, 40.0), "the simulator did not finish")
+        rospy.sleep(2.0)  # a costmap update and publish after the last frame
+        self.assertTrue(wait_until(lambda: self.costmap.received, 10.0), "no costmap")
+        self.assertTrue(wait_until(lambda: self.voxels is not None, 10.0), "no voxel cloud")
+        scene = room_scene()
+        table = scene.boxes[1]
+        tx, ty, tz = table.center
+        hx, hy, _ = table.half_extents
+        # The table top's columns are lethal, centre and near a corner.
+        self.assertEqual(self.costmap.cell(tx, ty), 100)
+        self.assertEqual(self.costmap.cell(tx + hx - 0.1, ty - hy + 0.1), 100)
+        # Under the top (its footprint shrunk by 0.1 m): floor voxels are occupied (the floor was
+        # seen through the space under the top), nothing between 0.1 m and the top is.
+        v = self.voxels
+        assert v is not None
+        under = (np.abs(v[:, 0] - tx) < hx - 0.1) & (np.abs(v[:, 1] - ty) < hy - 0.1)
+        self.assertGreater(int((under & (v[:, 2] < 0.05)).sum()), 10, "floor under it not seen")
+        self.assertEqual(int((under & (v[:, 2] > 0.1) & (v[:, 2] < tz - 0.1)).sum()), 0)
+        self.assertGreater(int((under & (np.abs(v[:, 2] - tz) < 0.05)).sum()), 20)
+        # The open floor between the objects: not lethal.
+        self.assertNotEqual(self.costmap.cell(0.0, 1.3), 100)
+        self.assertNotEqual(self.costmap.cell(-1.0, -1.5), 100)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("downstream_perception", "test_voxel_layer", VoxelLayerTest)
