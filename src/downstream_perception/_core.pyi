@@ -41,6 +41,9 @@ __all__: list[str] = [
     "TsdfConfig",
     "TsdfIntegrationStats",
     "TsdfWeighting",
+    "VoxelMap",
+    "VoxelMapConfig",
+    "VoxelRayConfig",
     "apply",
     "bresenham_line",
     "chi_square_quantile",
@@ -69,6 +72,7 @@ __all__: list[str] = [
     "static_map_values",
     "swept_polygon",
     "uncertainty_radius",
+    "voxel_ray",
 ]
 
 class GridGeometry:
@@ -1356,6 +1360,226 @@ class CorrectionMonitor:
     @property
     def resets(self) -> int: ...
 
+class VoxelMapConfig:
+    """
+    3-D voxel obstacle map settings (costmap_2d VoxelLayer's meaning).
+    """
+
+    log_odds: LogOddsConfig
+    def __init__(self) -> None: ...
+    def validate(self) -> str:
+        """
+        Empty string if valid, else the reason.
+        """
+    @property
+    def decay_time_s(self) -> float:
+        """
+        0 = no decay
+        """
+    @decay_time_s.setter
+    def decay_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def mark_threshold(self) -> int:
+        """
+        a column with more occupied band voxels than this is lethal
+        """
+    @mark_threshold.setter
+    def mark_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    @property
+    def max_memory_mib(self) -> float: ...
+    @max_memory_mib.setter
+    def max_memory_mib(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def max_obstacle_height_m(self) -> float: ...
+    @max_obstacle_height_m.setter
+    def max_obstacle_height_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def min_obstacle_height_m(self) -> float: ...
+    @min_obstacle_height_m.setter
+    def min_obstacle_height_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def origin_z_m(self) -> float:
+        """
+        bottom of voxel layer 0 (m)
+        """
+    @origin_z_m.setter
+    def origin_z_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def resolution_m(self) -> float:
+        """
+        voxel edge in x, y (m)
+        """
+    @resolution_m.setter
+    def resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def unknown_threshold(self) -> int:
+        """
+        a column with at most this many unknown band voxels is known
+        """
+    @unknown_threshold.setter
+    def unknown_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    @property
+    def z_resolution_m(self) -> float:
+        """
+        voxel height (m)
+        """
+    @z_resolution_m.setter
+    def z_resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def z_voxels(self) -> int:
+        """
+        voxels per column
+        """
+    @z_voxels.setter
+    def z_voxels(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+
+class VoxelRayConfig:
+    """
+    How far a source's rays mark and clear.
+    """
+
+    clearing: bool
+    marking: bool
+    def __init__(self) -> None: ...
+    def validate(self) -> str:
+        """
+        Empty string if valid, else the reason.
+        """
+    @property
+    def no_return_range_m(self) -> float: ...
+    @no_return_range_m.setter
+    def no_return_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def obstacle_max_range_m(self) -> float: ...
+    @obstacle_max_range_m.setter
+    def obstacle_max_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def one_ray_per_end_voxel(self) -> bool:
+        """
+        cast only the first ray of a frame ending in each voxel
+        """
+    @one_ray_per_end_voxel.setter
+    def one_ray_per_end_voxel(self, arg0: bool) -> None: ...
+    @property
+    def raytrace_max_range_m(self) -> float: ...
+    @raytrace_max_range_m.setter
+    def raytrace_max_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+
+class VoxelMap:
+    """
+    Sparse 3-D log-odds voxels over a rolling window.
+    """
+    def __init__(
+        self,
+        config: VoxelMapConfig,
+        anchor_x_m: typing.SupportsFloat | typing.SupportsIndex,
+        anchor_y_m: typing.SupportsFloat | typing.SupportsIndex,
+        nx: typing.SupportsInt | typing.SupportsIndex,
+        ny: typing.SupportsInt | typing.SupportsIndex,
+    ) -> None:
+        """
+        Raises ValueError for an invalid config, anchor or window size.
+        """
+    def clear(self) -> None:
+        """
+        Forgets everything (all voxels unknown).
+        """
+    def column(
+        self,
+        x: typing.SupportsInt | typing.SupportsIndex,
+        y: typing.SupportsInt | typing.SupportsIndex,
+        now_s: typing.SupportsFloat | typing.SupportsIndex,
+    ) -> tuple[int, int, int]:
+        """
+        (occupied, unknown, cost) of a column within the height band.
+        """
+    def integrate(
+        self,
+        origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"],
+        hits: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 3]"],
+        no_returns: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 3]"],
+        stamp_s: typing.SupportsFloat | typing.SupportsIndex,
+        rays: VoxelRayConfig,
+    ) -> dict:
+        """
+        One frame: hits (N x 3, world, m) mark and clear; no_returns (M x 3) give directions that clear no_return_range_m. Returns the counts.
+        """
+    def integrate_depth(
+        self,
+        depth: typing.Annotated[numpy.typing.ArrayLike, numpy.float32],
+        camera: PinholeCamera,
+        T_world_camera: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"],
+        stamp_s: typing.SupportsFloat | typing.SupportsIndex,
+        rays: VoxelRayConfig,
+        zero_is_no_return: bool = False,
+        stride: typing.SupportsInt | typing.SupportsIndex = 1,
+    ) -> dict:
+        """
+        A depth image (metres, REP 118: +Inf = no return) as one frame.
+        """
+    def log_odds(
+        self,
+        x: typing.SupportsInt | typing.SupportsIndex,
+        y: typing.SupportsInt | typing.SupportsIndex,
+        z: typing.SupportsInt | typing.SupportsIndex,
+        now_s: typing.SupportsFloat | typing.SupportsIndex,
+    ) -> float:
+        """
+        Log-odds of voxel (x, y, z) at time now_s (s; after decay).
+        """
+    def occupied_centres(
+        self, now_s: typing.SupportsFloat | typing.SupportsIndex
+    ) -> numpy.typing.NDArray[numpy.float32]:
+        """
+        Centres (N x 3, m) of the occupied voxels.
+        """
+    def project(
+        self, now_s: typing.SupportsFloat | typing.SupportsIndex
+    ) -> numpy.typing.NDArray[numpy.uint8]:
+        """
+        Column costs (ny, nx): 254 lethal, 0 free, 255 unknown.
+        """
+    def prune(self, now_s: typing.SupportsFloat | typing.SupportsIndex) -> int:
+        """
+        Frees the blocks in which no voxel is known any more at now_s (decay); returns the blocks freed.
+        """
+    def set_window(
+        self,
+        x0: typing.SupportsInt | typing.SupportsIndex,
+        y0: typing.SupportsInt | typing.SupportsIndex,
+        nx: typing.SupportsInt | typing.SupportsIndex,
+        ny: typing.SupportsInt | typing.SupportsIndex,
+    ) -> None:
+        """
+        Moves / resizes the window to nx x ny columns from column (x0, y0) (voxel indices); voxels inside both windows are kept, the others forgotten.
+        """
+    def state(
+        self,
+        x: typing.SupportsInt | typing.SupportsIndex,
+        y: typing.SupportsInt | typing.SupportsIndex,
+        z: typing.SupportsInt | typing.SupportsIndex,
+        now_s: typing.SupportsFloat | typing.SupportsIndex,
+    ) -> int:
+        """
+        -1 unknown, 0 free, 1 occupied.
+        """
+    @property
+    def band(self) -> tuple[int, int]: ...
+    @property
+    def blocks(self) -> int: ...
+    @property
+    def config(self) -> VoxelMapConfig: ...
+    @property
+    def max_blocks(self) -> int: ...
+    @property
+    def memory_bytes(self) -> int: ...
+    @property
+    def shape(self) -> tuple[int, int, int]: ...
+    @property
+    def window_offset(self) -> tuple[int, int]: ...
+    @property
+    def window_origin(self) -> tuple[float, float]: ...
+
 def apply(
     arg0: Pose2D, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]
 ) -> numpy.typing.NDArray[numpy.float64]:
@@ -1590,6 +1814,16 @@ def uncertainty_radius(
 ) -> float:
     """
     k sigma of the predicted position dt_s after the stamp, m (capped).
+    """
+
+def voxel_ray(
+    box: typing.Annotated[numpy.typing.ArrayLike, numpy.int32, "[3, 1]"],
+    p0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"],
+    p1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"],
+    include_end: bool = True,
+) -> numpy.typing.NDArray[numpy.int32]:
+    """
+    The voxels (N x 3) of the segment p0-p1 (voxel units) in the box [0, nx) x [0, ny) x [0, nz), in order, each once; empty when it misses the box or is not finite.
     """
 
 FREE_SPACE: int = 0

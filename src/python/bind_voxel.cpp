@@ -50,9 +50,10 @@ py::dict statsToDict(const VoxelIntegrationStats& s) {
   d["cleared"] = s.cleared;
   d["voxels_walked"] = s.voxels_walked;
   d["dropped_updates"] = s.dropped_updates;
-  d["touched"] = s.touched.empty() ? py::make_tuple()
-                                   : py::make_tuple(s.touched.min_x, s.touched.min_y,
-                                                    s.touched.max_x, s.touched.max_y);
+  // Both branches as py::tuple: pybind11 3 gives each make_tuple its own typed tuple type.
+  d["touched"] = s.touched.empty() ? py::tuple(py::make_tuple())
+                                   : py::tuple(py::make_tuple(s.touched.min_x, s.touched.min_y,
+                                                              s.touched.max_x, s.touched.max_y));
   return d;
 }
 
@@ -124,7 +125,9 @@ void bindVoxel(py::module& m) {
       .def_property_readonly("max_blocks", &VoxelMap::maxBlocks)
       .def_property_readonly("memory_bytes", &VoxelMap::memoryBytes)
       .def("set_window", &VoxelMap::setWindow, py::arg("x0"), py::arg("y0"), py::arg("nx"),
-           py::arg("ny"))
+           py::arg("ny"),
+           "Moves / resizes the window to nx x ny columns from column (x0, y0) (voxel indices); "
+           "voxels inside both windows are kept, the others forgotten.")
       .def(
           "integrate",
           [](VoxelMap& self, const Eigen::Vector3d& origin, const PointRows& hits,
@@ -176,7 +179,8 @@ void bindVoxel(py::module& m) {
             checkVoxel(self, x, y, z);
             return self.logOdds(x, y, z, now_s);
           },
-          py::arg("x"), py::arg("y"), py::arg("z"), py::arg("now_s"))
+          py::arg("x"), py::arg("y"), py::arg("z"), py::arg("now_s"),
+          "Log-odds of voxel (x, y, z) at time now_s (s; after decay).")
       .def(
           "state",
           [](const VoxelMap& self, int x, int y, int z, double now_s) {
@@ -217,8 +221,10 @@ void bindVoxel(py::module& m) {
             return out;
           },
           py::arg("now_s"), "Centres (N x 3, m) of the occupied voxels.")
-      .def("prune", &VoxelMap::prune, py::arg("now_s"))
-      .def("clear", &VoxelMap::clear);
+      .def("prune", &VoxelMap::prune, py::arg("now_s"),
+           "Frees the blocks in which no voxel is known any more at now_s (decay); returns the "
+           "blocks freed.")
+      .def("clear", &VoxelMap::clear, "Forgets everything (all voxels unknown).");
 
   m.def(
       "voxel_ray",
