@@ -2,12 +2,12 @@
 #   make demo   installs what is missing, builds, runs the synthetic demo headless, writes
 #               out/demo.png (rviz screenshot) and out/demo_report.md
 #   make test   runs every test (gtest, rostest, pytest); exits non-zero if any fails
-# Hardening (README "Hardening and CI"):
+# Hardening (docs/development.md, "Hardening and CI"):
 #   make test-sanitize   ASan+UBSan build (.ws-san) running the gtests and the pytests
 #   make fuzz            fixed-seed fuzz campaign (FUZZ_CASES=20000 by default, FUZZ_SEED=17)
 #   make fuzz-sanitize   the binding part of that campaign against the sanitized module
 #   make pip-check       pip install . in a fresh venv without ROS, then the pytests there
-# Soaks (README "Benchmarks"):
+# Soaks (docs/benchmarks.md):
 #   make soak            10-minute soaks of the costmap and TSDF nodelets (SOAK_MINUTES=10,
 #                        SOAK_ONLY=costmap|tsdf): RSS and messages handled, out/soak.md
 SHELL := /bin/bash
@@ -40,7 +40,7 @@ install-check: build
 test-sanitize: deps
 	@tools/test_sanitize.sh
 
-# pyproject.toml: the ROS-free core as a Python package (README "Python without ROS").
+# pyproject.toml: the ROS-free core as a Python package (docs/python.md, "Python without ROS").
 pip-check: deps
 	@tools/pip_check.sh
 

@@ -7,7 +7,7 @@ base_link->laser, and std_msgs/Bool(True) on latched `sim_done` when the traject
 and scans go on from the final pose). With ~detection_rate_hz > 0 it also plays an object
 detector: the world's moving objects within ~detection_range_m on `detections`
 (DetectedObjectArray in base_link, Gaussian position noise, sizes, labels, truth ids).
-Parameters: see README ("Simulator node").
+Parameters: docs/demo.md ("Lidar simulator").
 """
 
 from __future__ import annotations
@@ -77,14 +77,11 @@ class SimNode:
         self.laser_x = float(p("~laser_x_m", 0.0))
         self.start_delay = float(p("~start_delay_s", 1.0))
         self.loop = bool(p("~loop", False))
-        self.frames = {
-            k: str(p(f"~{k}_frame", d))
-            for k, d in (
-                ("map", "map"),
-                ("odom", "odom"),
-                ("base", "base_link"),
-                ("laser", "laser"),
-            )
+        self.frames = {  # each key spelt out: the docs test finds the parameters by name
+            "map": str(p("~map_frame", "map")),
+            "odom": str(p("~odom_frame", "odom")),
+            "base": str(p("~base_frame", "base_link")),
+            "laser": str(p("~laser_frame", "laser")),
         }
         ox, oy, oyaw = (float(v) for v in p("~odom_offset", [0.5, -0.2, 0.05]))
         self.map_odom = se2_matrix(ox, oy, oyaw)

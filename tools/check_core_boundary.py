@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The ROS-free core as a rule, not a habit (README "Layout").
+"""The ROS-free core as a rule, not a habit (docs/development.md, "Layout").
 
 Debian installs ROS headers in /usr/include next to everything else, so a ROS include in the core
 would compile. This check fails instead:

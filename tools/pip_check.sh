@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `pip install .` as a Python user without ROS does it (README "Python without ROS"): a fresh venv
+# `pip install .` as a Python user without ROS does it (docs/python.md, "Python without ROS"): a fresh venv
 # with no system site packages ($WS/pip-venv, numpy 2 from PyPI), the package built by pip
 # (pyproject.toml, scikit-build-core, pybind11 from PyPI) from a copy of the tracked files, then
 # the pytests in that venv with an environment that has no ROS in it (env -i): the ones that need

@@ -81,6 +81,9 @@ try:
         TsdfConfig,
         TsdfIntegrationStats,
         TsdfWeighting,
+        VoxelMap,
+        VoxelMapConfig,
+        VoxelRayConfig,
         apply,
         bresenham_line,
         chi_square_quantile,
@@ -108,6 +111,7 @@ try:
         static_map_values,
         swept_polygon,
         uncertainty_radius,
+        voxel_ray,
     )
 
     _CORE_IMPORT_ERROR: ImportError | None = None

@@ -267,7 +267,7 @@ void LogOddsObstacleLayer::readSources(const std::string& names) {
     ic.marking = true;
     reader.get("clearing", &ic.clearing);
     reader.get("marking", &ic.marking);
-    // Ours (see README): finer ranges, REP-117 no-return clearing, tf queue, de-skew.
+    // Ours (docs/costmap.md): finer ranges, REP-117 no-return clearing, tf queue, de-skew.
     ic.inf_is_valid = false;
     reader.get("inf_is_no_return", &ic.inf_is_valid);
     reader.get("range_max_is_no_return", &ic.range_max_is_no_return);

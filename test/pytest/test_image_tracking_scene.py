@@ -3,9 +3,9 @@ motmetrics (IoU >= 0.5), against a ByteTrack-style reference (bytetrack_referenc
 
 Two scene types (street: 10 people at 30 fps, crowd: 16 people at 25 fps with a weaker
 detector), three seeds each. Seeds 10-12 are held out: the image-mode defaults were chosen on
-seeds 0-7 (README "Tracking core"). The floors are the lowest per-scene means measured on these
-seeds less a margin for the scene's seed-to-seed spread; the comparison with the reference is on
-the same detections.
+seeds 0-7 (docs/tracker.md, "Tracking core"). The floors are the lowest per-scene means measured
+on these seeds less a margin for the scene's seed-to-seed spread; the comparison with the
+reference is on the same detections.
 """
 
 from __future__ import annotations

@@ -160,7 +160,7 @@ def test_footprint_and_inscribed_radius() -> None:
 
 
 def test_inflation_formula_and_translation() -> None:
-    """The README's example (0.2 m inscribed, factor 3, 5 cm): 253 / 186 / 138 at 4 / 6 / 8."""
+    """docs/costmap.md's example (0.2 m inscribed, factor 3, 5 cm): 253 / 186 / 138 at 4 / 6 / 8."""
     inf = mbc.Inflation(
         inflation_radius=0.55, cost_scaling_factor=3.0, inscribed_radius=0.2, resolution=0.05
     )

@@ -7,7 +7,7 @@ per frame, 10 % of true detections with a low score. Scored two ways, as in the 
 count; coasting tracks are reported, which is what a planner wants).
 The anchors (abewley/sort and ByteTrack tuned on a comparable scene, N = 30): MOTA 0.88 / IDF1
 0.80-0.82 / 32-73 ID switches per 30 s visible, MOTA 0.75 all. Seeds 0-2 have been the scoring
-seeds since the scene was written; the README also reports seeds 0-10.
+seeds since the scene was written; docs/tracker.md also reports seeds 0-10.
 """
 
 from __future__ import annotations

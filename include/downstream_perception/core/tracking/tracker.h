@@ -97,9 +97,9 @@ struct TrackerConfig {
   std::string validate() const;
 
   /// The documented defaults of a mode. Metric: the member initialisers. Image (chosen on the
-  /// pinhole scenes of sim.image_scene, several seeds, 25 and 30 fps; README "Tracking core"):
-  /// the same noise levels read in box heights, and min_hits 2, because with 3 a person who is
-  /// missed once in the first frames is dropped and found again frames later (recall).
+  /// pinhole scenes of sim.image_scene, several seeds, 25 and 30 fps; docs/tracker.md, "Tracking
+  /// core"): the same noise levels read in box heights, and min_hits 2, because with 3 a person who
+  /// is missed once in the first frames is dropped and found again frames later (recall).
   static TrackerConfig defaultsFor(Mode mode);
   /// The parameters whose default in `mode` differs from the metric one, by their YAML / field
   /// name, with the mode's value: what a node applies to the keys its user left unset.

@@ -1,4 +1,5 @@
-"""The README's Python examples run as written and give what their comments say."""
+"""The Python examples of the README and of docs/ run as written and give what their comments
+say."""
 
 from __future__ import annotations
 
@@ -6,19 +7,20 @@ from pathlib import Path
 
 import numpy as np
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+ROOT = Path(__file__).resolve().parents[2]
+DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
 def run_blocks() -> list[dict[str, object]]:
-    """Each ```python block of the README, run in a fresh namespace (each must stand alone)."""
-    text = README.read_text()
-    blocks = [part.split("```", 1)[0] for part in text.split("```python")[1:]]
-    assert len(blocks) >= 2
+    """Each ```python block of the README and docs/, run in a fresh namespace (stands alone)."""
     namespaces = []
-    for code in blocks:
-        namespace: dict[str, object] = {}
-        exec(compile(code, str(README), "exec"), namespace)  # noqa: S102
-        namespaces.append(namespace)
+    for document in DOCUMENTS:
+        text = document.read_text()
+        for code in (part.split("```", 1)[0] for part in text.split("```python")[1:]):
+            namespace: dict[str, object] = {}
+            exec(compile(code, str(document), "exec"), namespace)  # noqa: S102
+            namespaces.append(namespace)
+    assert len(namespaces) >= 6
     return namespaces
 
 
