@@ -365,3 +365,28 @@ def test_every_bound_name_is_in_the_python_page() -> None:
     public = {n for n in dir(core) if not n.startswith("_") and n != "pybind11_version"}
     missing = sorted(n for n in public if f"`{n}`" not in text)
     assert not missing, f"docs/python.md does not list {missing}"
+
+
+def test_replay_options_table_matches_the_parser() -> None:
+    cli = ROOT / "src" / "downstream_perception" / "replay" / "cli.py"
+    options = re.findall(r'add_argument\(\s*"(--[\w-]+)"', cli.read_text())
+    text = (DOCS / "replay.md").read_text()
+    table = text[text.index("| option | default | meaning |") :].split("\n\n", 1)[0]
+    documented: dict[str, str] = {}
+    for line in table.splitlines()[2:]:
+        c = cells(line)
+        names = re.findall(r"`(--[\w-]+)`", c[0])
+        documented.update(split_defaults(names, c[1]))
+    assert sorted(documented) == sorted(options)
+    parse = pytest.importorskip("downstream_perception.replay.cli", reason="needs rosbag").parse
+    defaults = vars(parse(["my.bag", "--config", "c.yaml"]))  # one capability is required
+    for option, text_default in documented.items():
+        if option == "--config":
+            continue
+        value = defaults[option[2:].replace("-", "_")]
+        if value is None or value is False:
+            assert text_default in ("", "off"), f"{option}: documented '{text_default}'"
+        else:
+            assert same(
+                literal(text_default), value if not isinstance(value, Path) else str(value)
+            ), f"{option}: documented '{text_default}', parser {value}"
