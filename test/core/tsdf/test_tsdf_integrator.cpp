@@ -405,3 +405,21 @@ TEST(Tsdf, FarAndNanPointsAreInvalidNotOverflowed) {
   EXPECT_FALSE(map.inBounds(Eigen::Vector3d(far, 0.0, 0.0)));
   EXPECT_TRUE(map.inBounds(Eigen::Vector3d(1e6, -1e6, 1e6)));
 }
+
+TEST(Tsdf, ZeroWeightObservationOfAnUnobservedVoxelLeavesItUnobserved) {
+  // With the drop-off, a voxel exactly mu behind the surface gets weight 0; on a voxel never
+  // observed that was 0 / 0 = NaN, and the NaN stayed through every later update (found on the
+  // lattice-aligned room with pose noise: the health's mean gradient came out NaN).
+  TsdfMap map(lessonConfig());
+  const TsdfVoxel unobserved;
+  const TsdfVoxel after = map.fused(unobserved, -1.0f, 0.0f);
+  EXPECT_EQ(after.weight, 0.0f);
+  EXPECT_EQ(after.distance, unobserved.distance);
+  const TsdfVoxel next = map.fused(after, 0.5f, 1.0f);
+  EXPECT_FLOAT_EQ(next.distance, 0.5f);
+  EXPECT_FLOAT_EQ(next.weight, 1.0f);
+  // An observed voxel and a zero-weight observation: unchanged.
+  const TsdfVoxel same = map.fused(next, -1.0f, 0.0f);
+  EXPECT_FLOAT_EQ(same.distance, 0.5f);
+  EXPECT_FLOAT_EQ(same.weight, 1.0f);
+}

@@ -13,7 +13,9 @@
 namespace downstream_perception {
 
 struct TsdfHealth {
-  std::size_t crossings = 0;           ///< neighbouring observed voxel pairs with a sign change
+  /// Neighbouring observed voxel pairs with a sign change, along an axis within 54.7 degrees of
+  /// the surface normal there (|grad_axis| >= |grad| / sqrt 3).
+  std::size_t crossings = 0;
   double mean_gradient_ratio = 0.0;    ///< mean |grad (D mu)| there (1 = healthy)
   double low_gradient_fraction = 0.0;  ///< share of crossings with |grad (D mu)| < 0.5
   std::size_t double_crossings = 0;    ///< + - + or - + - within mu along an axis

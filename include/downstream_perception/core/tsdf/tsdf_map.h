@@ -155,7 +155,11 @@ class TsdfMap {
   /// of values, so the integrator's loop over a row of voxels vectorises.
   TsdfVoxel fused(const TsdfVoxel& v, float d, float w) const {
     const float total = v.weight + w;
-    return {(v.weight * v.distance + w * d) / total, std::min(total, weight_cap_)};
+    // A zero-weight observation of an unobserved voxel (exactly mu behind the surface with the
+    // drop-off) would be 0 / 0: the voxel keeps its value and stays unobserved. A select, so the
+    // integration loop still vectorises.
+    const float average = (v.weight * v.distance + w * d) / total;
+    return {total > 0.0f ? average : v.distance, std::min(total, weight_cap_)};
   }
   /// Fuses one observation (normalised distance d, weight w) into a voxel.
   void fuse(TsdfVoxel* v, float d, float w) const { *v = fused(*v, d, w); }
