@@ -39,27 +39,37 @@ void bindLogOddsGrid(py::module& m) {
                             "Inverse sensor model and thresholds of the log-odds obstacle grid "
                             "(probabilities, log-odds).")
       .def(py::init<>())
-      .def_readwrite("p_hit", &LogOddsConfig::p_hit)
-      .def_readwrite("p_miss", &LogOddsConfig::p_miss)
-      .def_readwrite("clamp_min", &LogOddsConfig::clamp_min)
-      .def_readwrite("clamp_max", &LogOddsConfig::clamp_max)
-      .def_readwrite("occupied_threshold", &LogOddsConfig::occupied_threshold)
-      .def_readwrite("free_threshold", &LogOddsConfig::free_threshold)
+      .def_readwrite("p_hit", &LogOddsConfig::p_hit,
+                     "inverse sensor model: P(occupied) given a return in the cell")
+      .def_readwrite("p_miss", &LogOddsConfig::p_miss,
+                     "P(occupied) given a beam passing through the cell")
+      .def_readwrite("clamp_min", &LogOddsConfig::clamp_min,
+                     "lower log-odds clamp (keeps free cells re-learnable)")
+      .def_readwrite("clamp_max", &LogOddsConfig::clamp_max,
+                     "upper log-odds clamp (keeps walls un-learnable in bounded time)")
+      .def_readwrite("occupied_threshold", &LogOddsConfig::occupied_threshold,
+                     "log-odds above this -> occupied (p > 0.881)")
+      .def_readwrite("free_threshold", &LogOddsConfig::free_threshold,
+                     "log-odds below this -> free (p < 0.119)")
       .def("validate", &LogOddsConfig::validate, "Empty string if valid, else the reason.");
 
   py::class_<LogOddsGrid>(m, "LogOddsGrid",
                           "Fixed-point log-odds occupancy grid (2 bytes per cell, quantum 1/1024).")
       .def(py::init<const GridGeometry&, const LogOddsConfig&>(), py::arg("geometry"),
            py::arg_v("config", LogOddsConfig{}, "LogOddsConfig()"))
-      .def_property_readonly("geometry", &LogOddsGrid::geometry)
-      .def_property_readonly("config", &LogOddsGrid::config)
-      .def_property_readonly_static("quantum", [](py::object) { return LogOddsGrid::kQuantum; })
+      .def_property_readonly("geometry", &LogOddsGrid::geometry, "the grid's geometry")
+      .def_property_readonly("config", &LogOddsGrid::config, "the configuration in use")
+      .def_property_readonly_static(
+          "quantum", [](py::object) { return LogOddsGrid::kQuantum; },
+          "log-odds per stored unit (1/1024)")
       .def_property_readonly(
           "hit_increment",
-          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.hitUnits()); })
+          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.hitUnits()); },
+          "log-odds added by a return, after rounding to the quantum")
       .def_property_readonly(
           "miss_increment",
-          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.missUnits()); })
+          [](const LogOddsGrid& g) { return LogOddsGrid::dequantize(g.missUnits()); },
+          "log-odds added by a pass, after rounding to the quantum")
       .def(
           "log_odds",
           [](const LogOddsGrid& g) {
@@ -141,7 +151,7 @@ void bindLogOddsGrid(py::module& m) {
           "Returns how many cells changed state.")
       .def("max_abs_log_odds", &LogOddsGrid::maxAbsLogOdds,
            "Largest |log-odds| over the grid (health metric: at the clamp, never beyond).")
-      .def_property_readonly("memory_bytes", &LogOddsGrid::memoryBytes);
+      .def_property_readonly("memory_bytes", &LogOddsGrid::memoryBytes, "bytes held by the cells");
 
   m.def("log_odds_of", &LogOddsGrid::logOddsOf, "log(p / (1 - p))");
   m.def("probability_of", &LogOddsGrid::probabilityOf, "1 - 1 / (1 + exp(l))");
@@ -153,14 +163,21 @@ void bindScanIntegration(py::module& m) {
       m, "ScanIntegratorConfig",
       "Ranges (m) and REP-117 options of the scan integrator (costmap_2d's obstacle-source keys).")
       .def(py::init<>())
-      .def_readwrite("marking", &ScanIntegratorConfig::marking)
-      .def_readwrite("clearing", &ScanIntegratorConfig::clearing)
-      .def_readwrite("obstacle_min_range", &ScanIntegratorConfig::obstacle_min_range)
-      .def_readwrite("obstacle_max_range", &ScanIntegratorConfig::obstacle_max_range)
-      .def_readwrite("raytrace_min_range", &ScanIntegratorConfig::raytrace_min_range)
-      .def_readwrite("raytrace_max_range", &ScanIntegratorConfig::raytrace_max_range)
-      .def_readwrite("inf_is_valid", &ScanIntegratorConfig::inf_is_valid)
-      .def_readwrite("range_max_is_no_return", &ScanIntegratorConfig::range_max_is_no_return)
+      .def_readwrite("marking", &ScanIntegratorConfig::marking, "returns mark their cell")
+      .def_readwrite("clearing", &ScanIntegratorConfig::clearing,
+                     "beams clear the cells they cross")
+      .def_readwrite("obstacle_min_range", &ScanIntegratorConfig::obstacle_min_range,
+                     "m: returns nearer than this do not mark")
+      .def_readwrite("obstacle_max_range", &ScanIntegratorConfig::obstacle_max_range,
+                     "m: returns farther than this do not mark")
+      .def_readwrite("raytrace_min_range", &ScanIntegratorConfig::raytrace_min_range,
+                     "m: clearing starts this far from the sensor")
+      .def_readwrite("raytrace_max_range", &ScanIntegratorConfig::raytrace_max_range,
+                     "m: clearing stops this far from the sensor")
+      .def_readwrite("inf_is_valid", &ScanIntegratorConfig::inf_is_valid,
+                     "+Inf means \"no return\": clear, do not mark")
+      .def_readwrite("range_max_is_no_return", &ScanIntegratorConfig::range_max_is_no_return,
+                     "treat r == range_max as +Inf")
       .def("validate", &ScanIntegratorConfig::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
            "raise).");
@@ -168,21 +185,34 @@ void bindScanIntegration(py::module& m) {
   py::class_<IntegrationStats>(m, "IntegrationStats",
                                "What one scan integration did: beams by kind, cells cleared, "
                                "marked and changed, touched and changed windows.")
-      .def_readonly("beams", &IntegrationStats::beams)
-      .def_readonly("beams_marked", &IntegrationStats::beams_marked)
-      .def_readonly("beams_no_return", &IntegrationStats::beams_no_return)
-      .def_readonly("beams_invalid", &IntegrationStats::beams_invalid)
-      .def_readonly("beams_beyond_obstacle_range", &IntegrationStats::beams_beyond_obstacle_range)
-      .def_readonly("cells_cleared", &IntegrationStats::cells_cleared)
-      .def_readonly("cells_marked", &IntegrationStats::cells_marked)
-      .def_readonly("cells_changed", &IntegrationStats::cells_changed)
-      .def_readonly("points_outside_height", &IntegrationStats::points_outside_height)
-      .def_readonly("points_merged", &IntegrationStats::points_merged)
+      .def_readonly("beams", &IntegrationStats::beams, "beams offered")
+      .def_readonly("beams_marked", &IntegrationStats::beams_marked,
+                    "beams whose hit cell got (or shared) a hit update")
+      .def_readonly("beams_no_return", &IntegrationStats::beams_no_return,
+                    "+Inf (or range_max when treated so) beams that cleared")
+      .def_readonly("beams_invalid", &IntegrationStats::beams_invalid,
+                    "NaN, -Inf, outside [range_min, range_max]")
+      .def_readonly("beams_beyond_obstacle_range", &IntegrationStats::beams_beyond_obstacle_range,
+                    "returns too far (or near) to mark")
+      .def_readonly(
+          "cells_cleared", &IntegrationStats::cells_cleared,
+          "Cells walked by clearing rays, per beam (a cell two beams cross counts twice, as in the "
+          "lesson's \"a 10 m beam clears ~200 cells\"). Each cell still receives at most one miss "
+          "update per scan, and none if it was hit in the same scan.")
+      .def_readonly("cells_marked", &IntegrationStats::cells_marked,
+                    "cells that received a hit update")
+      .def_readonly("cells_changed", &IntegrationStats::cells_changed,
+                    "cells whose state (free/occupied/unknown) changed")
+      .def_readonly("points_outside_height", &IntegrationStats::points_outside_height,
+                    "cloud points outside [min, max]_obstacle_height")
+      .def_readonly("points_merged", &IntegrationStats::points_merged,
+                    "cloud points sharing a merge cell with an earlier one")
       .def_property_readonly(
           "touched", [](const IntegrationStats& s) { return boundsToTuple(s.touched); },
           "(min_x, min_y, max_x, max_y) inclusive, or () if nothing was touched")
-      .def_property_readonly("changed",
-                             [](const IntegrationStats& s) { return boundsToTuple(s.changed); })
+      .def_property_readonly(
+          "changed", [](const IntegrationStats& s) { return boundsToTuple(s.changed); },
+          "(x0, y0, x1, y1) cells whose state changed, or None")
       .def("clear_mark_ratio", &IntegrationStats::clearMarkRatio,
            "Cells cleared per cell marked (the phantom-wall diagnostic; healthy >> 1).");
 
@@ -191,7 +221,7 @@ void bindScanIntegration(py::module& m) {
                              "first, then each cell cleared at most once per scan.")
       .def(py::init<const ScanIntegratorConfig&>(),
            py::arg_v("config", ScanIntegratorConfig{}, "ScanIntegratorConfig()"))
-      .def_property_readonly("config", &ScanIntegrator::config)
+      .def_property_readonly("config", &ScanIntegrator::config, "the configuration in use")
       .def(
           "integrate",
           [](ScanIntegrator& self, LogOddsGrid& grid,
@@ -281,14 +311,26 @@ void bindStaticMap(py::module& m) {
                               "How an OccupancyGrid becomes costs (map_server's thresholds, "
                               "track_unknown_space, trinary_costmap).")
       .def(py::init<>())
-      .def_readwrite("track_unknown_space", &StaticMapConfig::track_unknown_space)
-      .def_readwrite("use_maximum", &StaticMapConfig::use_maximum)
-      .def_readwrite("lethal_cost_threshold", &StaticMapConfig::lethal_cost_threshold,
-                     "occupancy value 0..100 (clamped) from which a cell is lethal")
-      .def_readwrite("unknown_cost_value", &StaticMapConfig::unknown_cost_value,
-                     "occupancy value meaning unknown, compared as a byte (-1 = 255)")
-      .def_readwrite("trinary_costmap", &StaticMapConfig::trinary_costmap)
-      .def_readwrite("max_cells", &StaticMapConfig::max_cells, "largest map accepted, cells");
+      .def_readwrite("track_unknown_space", &StaticMapConfig::track_unknown_space,
+                     "costmap_2d's StaticLayer default (layer level)")
+      .def_readwrite("use_maximum", &StaticMapConfig::use_maximum,
+                     "combine with the master by max instead of overwriting")
+      .def_readwrite(
+          "lethal_cost_threshold", &StaticMapConfig::lethal_cost_threshold,
+          "occupancy value (0..100) from which a cell is lethal (occupancy value (0..100) from "
+          "which a cell is lethal (occupancy value 0..100 (clamped) from which a cell is lethal))")
+      .def_readwrite(
+          "unknown_cost_value", &StaticMapConfig::unknown_cost_value,
+          "occupancy value meaning unknown (compared as a byte) (occupancy value meaning unknown "
+          "(compared as a byte) (occupancy value meaning unknown, compared as a byte (-1 = 255)))")
+      .def_readwrite("trinary_costmap", &StaticMapConfig::trinary_costmap,
+                     "false: below-lethal values scale to 0..253")
+      .def_readwrite(
+          "max_cells", &StaticMapConfig::max_cells,
+          "Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one "
+          "byte per cell here, one in the master, one in each published grid). (Largest map "
+          "accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell "
+          "here, one in the master, one in each published grid). (largest map accepted, cells))");
   m.def(
       "static_map_values",
       [](py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> occupancy,
@@ -340,9 +382,10 @@ void bindStaticMap(py::module& m) {
           py::arg("x"), py::arg("y"), py::arg("data"),
           "map_msgs/OccupancyGridUpdate: rewrites [x, x + w) x [y, y + h); ValueError (nothing "
           "written) if the window is not inside the map.")
-      .def_property_readonly("has_map", &StaticMap::hasMap)
-      .def_property_readonly("geometry",
-                             [](const StaticMap& self) { return self.costs().geometry(); })
+      .def_property_readonly("has_map", &StaticMap::hasMap, "whether a map was accepted")
+      .def_property_readonly(
+          "geometry", [](const StaticMap& self) { return self.costs().geometry(); },
+          "the grid's geometry")
       .def(
           "costs",
           [](const StaticMap& self) {
@@ -367,10 +410,14 @@ void bindInflationAndFootprint(py::module& m) {
                               "Inflation radius and inscribed radius (m) and cost_scaling_factor "
                               "(1/m), as costmap_2d's InflationLayer.")
       .def(py::init<>())
-      .def_readwrite("inflation_radius", &InflationConfig::inflation_radius, "m")
-      .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor, "1/m")
-      .def_readwrite("inscribed_radius", &InflationConfig::inscribed_radius, "m")
-      .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown)
+      .def_readwrite("inflation_radius", &InflationConfig::inflation_radius,
+                     "m: cells farther than this from any lethal cell get 0")
+      .def_readwrite("cost_scaling_factor", &InflationConfig::cost_scaling_factor,
+                     "1/m: exponential decay rate beyond the inscribed radius")
+      .def_readwrite("inscribed_radius", &InflationConfig::inscribed_radius,
+                     "m: from the footprint; cells this close get 253")
+      .def_readwrite("inflate_unknown", &InflationConfig::inflate_unknown,
+                     "write inflated costs over NO_INFORMATION cells (costmap_2d)")
       .def_readonly_static("MAX_RADIUS_CELLS", &InflationConfig::kMaxRadiusCells,
                            "largest inflation_radius / resolution accepted")
       .def("validate", py::overload_cast<>(&InflationConfig::validate, py::const_),

@@ -63,20 +63,29 @@ void bindEsdf(py::module& m) {
       m, "EsdfConfig",
       "Parameters of the Euclidean signed distance field computed from the TSDF (metres).")
       .def(py::init<>())
-      .def_readwrite("max_distance_m", &EsdfConfig::max_distance_m,
-                     "distances are clamped at this (m); also a change's reach")
+      .def_readwrite(
+          "max_distance_m", &EsdfConfig::max_distance_m,
+          "Distances are clamped at this (m). Also the reach of a change: a voxel that changes "
+          "state alters distances within this radius only. (Distances are clamped at this (m). "
+          "Also the reach of a change: a voxel that changes state alters distances within this "
+          "radius only. (distances are clamped at this (m); also a change's reach))")
       .def("validate", &EsdfConfig::validate, py::arg("voxel_size_m"),
            "Empty string if valid for TSDF voxels of voxel_size_m (m), else the reason.");
   py::class_<EsdfUpdateStats>(
       m, "EsdfUpdateStats",
       "What one ESDF update did: full or incremental, regions, voxels changed.")
-      .def_readonly("full", &EsdfUpdateStats::full)
-      .def_readonly("blocks_read", &EsdfUpdateStats::blocks_read)
-      .def_readonly("blocks_removed", &EsdfUpdateStats::blocks_removed)
-      .def_readonly("voxels_changed", &EsdfUpdateStats::voxels_changed)
-      .def_readonly("blocks_written", &EsdfUpdateStats::blocks_written)
-      .def_readonly("regions", &EsdfUpdateStats::regions)
-      .def_readonly("region_voxels", &EsdfUpdateStats::region_voxels);
+      .def_readonly("full", &EsdfUpdateStats::full, "every block recomputed")
+      .def_readonly("blocks_read", &EsdfUpdateStats::blocks_read,
+                    "TSDF blocks re-read (integrated since the last update)")
+      .def_readonly("blocks_removed", &EsdfUpdateStats::blocks_removed,
+                    "blocks the TSDF no longer has")
+      .def_readonly("voxels_changed", &EsdfUpdateStats::voxels_changed,
+                    "voxels whose state changed")
+      .def_readonly("blocks_written", &EsdfUpdateStats::blocks_written,
+                    "blocks whose distances were recomputed")
+      .def_readonly("regions", &EsdfUpdateStats::regions, "distance-transform regions")
+      .def_readonly("region_voxels", &EsdfUpdateStats::region_voxels,
+                    "voxels in those regions (seed margins included)");
 
   auto tsdf = py::reinterpret_borrow<py::class_<Tsdf>>(m.attr("Tsdf"));
   tsdf.def_property_readonly(
@@ -138,8 +147,9 @@ void bindEsdf(py::module& m) {
           "esdf_voxels", [](Tsdf& self) { return knownVoxels(esdfOf(self)); },
           "Every known ESDF voxel: dict of voxels (N, 3) int32 lattice indices (centre = index "
           "* voxel_size_m), distance (N,) float32 m, occupied (N,) int8.")
-      .def_property_readonly("esdf_block_count",
-                             [](Tsdf& self) { return esdfOf(self).blockCount(); })
+      .def_property_readonly(
+          "esdf_block_count", [](Tsdf& self) { return esdfOf(self).blockCount(); },
+          "ESDF blocks (at most one per TSDF block)")
       .def_property_readonly(
           "esdf_memory_bytes", [](Tsdf& self) { return esdfOf(self).memoryBytes(); },
           "Bytes held by the ESDF's blocks, hash table and scratch.");

@@ -37,11 +37,11 @@ void bindGrid(py::module& m) {
                            "lower-left corner. Arrays are indexed [y, x].")
       .def(py::init<int, int, double, double, double>(), py::arg("size_x"), py::arg("size_y"),
            py::arg("resolution"), py::arg("origin_x") = 0.0, py::arg("origin_y") = 0.0)
-      .def_property_readonly("size_x", &GridGeometry::sizeX)
-      .def_property_readonly("size_y", &GridGeometry::sizeY)
-      .def_property_readonly("resolution", &GridGeometry::resolution)
-      .def_property_readonly("origin_x", &GridGeometry::originX)
-      .def_property_readonly("origin_y", &GridGeometry::originY)
+      .def_property_readonly("size_x", &GridGeometry::sizeX, "cells along x")
+      .def_property_readonly("size_y", &GridGeometry::sizeY, "cells along y")
+      .def_property_readonly("resolution", &GridGeometry::resolution, "cell edge, m")
+      .def_property_readonly("origin_x", &GridGeometry::originX, "x of the lower-left corner, m")
+      .def_property_readonly("origin_y", &GridGeometry::originY, "y of the lower-left corner, m")
       .def(
           "world_to_cell",
           [](const GridGeometry& g, double wx, double wy) {
@@ -85,9 +85,9 @@ void bindGrid(py::module& m) {
       "A 2-D pose (x, y in metres, yaw in radians, REP-103): child frame in parent frame.")
       .def(py::init<double, double, double>(), py::arg("x") = 0.0, py::arg("y") = 0.0,
            py::arg("yaw") = 0.0)
-      .def_readwrite("x", &Pose2D::x)
-      .def_readwrite("y", &Pose2D::y)
-      .def_readwrite("yaw", &Pose2D::yaw)
+      .def_readwrite("x", &Pose2D::x, "m")
+      .def_readwrite("y", &Pose2D::y, "m")
+      .def_readwrite("yaw", &Pose2D::yaw, "rad, counter-clockwise from x")
       .def(
           "as_tuple", [](const Pose2D& p) { return py::make_tuple(p.x, p.y, p.yaw); },
           "(x, y, yaw) as a tuple.")

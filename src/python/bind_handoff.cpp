@@ -33,20 +33,31 @@ void bindHandoff(py::module& m) {
         py::arg("age_s"), "range * tan(|yaw rate| * age): sideways throw of a late transform, m.");
   py::class_<SeamLimits>(m, "SeamLimits", "The seam health's warning limits (handoff keys).")
       .def(py::init<>())
-      .def_readwrite("reference_range_m", &SeamLimits::reference_range_m, "m")
-      .def_readwrite("max_transform_age_s", &SeamLimits::max_transform_age_s, "s")
-      .def_readwrite("max_smear_m", &SeamLimits::max_smear_m, "m")
-      .def_readwrite("max_map_odom_age_s", &SeamLimits::max_map_odom_age_s, "s");
+      .def_readwrite("reference_range_m", &SeamLimits::reference_range_m,
+                     "m: the range at which the smear is judged")
+      .def_readwrite("max_transform_age_s", &SeamLimits::max_transform_age_s,
+                     "s: warn when an input's p95 transform age exceeds it")
+      .def_readwrite("max_smear_m", &SeamLimits::max_smear_m,
+                     "m: warn when the expected smear exceeds it")
+      .def_readwrite("max_map_odom_age_s", &SeamLimits::max_map_odom_age_s,
+                     "s: warn when map <- odom is older");
   py::class_<CorrectionMonitorConfig>(
       m, "CorrectionMonitorConfig",
       "Limits of the map <- odom correction monitor (metres, seconds).")
       .def(py::init<>())
-      .def_readwrite("window_s", &CorrectionMonitorConfig::window_s, "s")
-      .def_readwrite("reset_drop_m", &CorrectionMonitorConfig::reset_drop_m, "m")
-      .def_readwrite("max_correction_m", &CorrectionMonitorConfig::max_correction_m, "m")
-      .def_readwrite("zero_epsilon_m", &CorrectionMonitorConfig::zero_epsilon_m, "m")
-      .def_readwrite("min_travel_m", &CorrectionMonitorConfig::min_travel_m, "m")
-      .def_readwrite("ramp_m", &CorrectionMonitorConfig::ramp_m, "m")
+      .def_readwrite("window_s", &CorrectionMonitorConfig::window_s, "s of history judged")
+      .def_readwrite("reset_drop_m", &CorrectionMonitorConfig::reset_drop_m,
+                     "m: a fall of the correction this large is a correction event")
+      .def_readwrite("max_correction_m", &CorrectionMonitorConfig::max_correction_m,
+                     "m: warn above (the lesson: 2 m ~ 100 m of 2 % drift)")
+      .def_readwrite("zero_epsilon_m", &CorrectionMonitorConfig::zero_epsilon_m,
+                     "m: a correction this small counts as zero")
+      .def_readwrite("min_travel_m", &CorrectionMonitorConfig::min_travel_m,
+                     "m of robot travel within the window after which a correction stuck at zero "
+                     "is suspicious (the localiser may be silently rejecting fixes).")
+      .def_readwrite("ramp_m", &CorrectionMonitorConfig::ramp_m,
+                     "m the correction must grow within the window without a single reset before "
+                     "it counts as \"never resets\" (loop closures not firing).")
       .def("validate", &CorrectionMonitorConfig::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
            "raise).");
@@ -68,7 +79,9 @@ void bindHandoff(py::module& m) {
           },
           py::arg("time_s"), py::arg("correction_m"), py::arg("travelled_m"),
           "Samples from three equally long arrays: time_s, correction_m, travelled_m.")
-      .def_property_readonly("resets", &CorrectionMonitor::resets)
+      .def_property_readonly(
+          "resets", &CorrectionMonitor::resets,
+          "corrections seen to reset (drops larger than reset_drop_m) in the window")
       .def("never_resets", &CorrectionMonitor::neverResets,
            "Whether the correction grew by ramp_m over the window without a reset.")
       .def("stuck_at_zero", &CorrectionMonitor::stuckAtZero,

@@ -82,12 +82,20 @@ void bindTracking(py::module& m) {
                                "How tracks are predicted into the costmap: horizon and step (s), "
                                "uncertainty growth, footprint margin (m).")
       .def(py::init<>())
-      .def_readwrite("prediction_horizon_s", &PredictionConfig::prediction_horizon_s, "s")
-      .def_readwrite("uncertainty_sigmas", &PredictionConfig::uncertainty_sigmas)
-      .def_readwrite("max_uncertainty_m", &PredictionConfig::max_uncertainty_m, "m")
-      .def_readwrite("min_object_size_m", &PredictionConfig::min_object_size_m, "m")
-      .def_readwrite("max_object_size_m", &PredictionConfig::max_object_size_m, "m")
-      .def_readwrite("max_speed_mps", &PredictionConfig::max_speed_mps, "m/s")
+      .def_readwrite("prediction_horizon_s", &PredictionConfig::prediction_horizon_s,
+                     "s: how far ahead of now the object is swept")
+      .def_readwrite(
+          "uncertainty_sigmas", &PredictionConfig::uncertainty_sigmas,
+          "k: the shape grows by k standard deviations of the predicted position (0 = box only).")
+      .def_readwrite(
+          "max_uncertainty_m", &PredictionConfig::max_uncertainty_m,
+          "m: cap on that growth, so a track with an absurd covariance cannot blank the map.")
+      .def_readwrite("min_object_size_m", &PredictionConfig::min_object_size_m,
+                     "m: smaller box sides are raised to this")
+      .def_readwrite("max_object_size_m", &PredictionConfig::max_object_size_m,
+                     "m: larger box sides are clamped to this (bad sizes)")
+      .def_readwrite("max_speed_mps", &PredictionConfig::max_speed_mps,
+                     "m/s: faster tracks are not swept (bad velocities)")
       .def("validate", &PredictionConfig::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
            "raise).");
@@ -110,13 +118,14 @@ void bindTracking(py::module& m) {
            py::arg("position_covariance") = Eigen::Matrix2d::Zero().eval(),
            py::arg("velocity_covariance") = Eigen::Matrix2d::Zero().eval(), py::arg("size_x") = 0.0,
            py::arg("size_y") = 0.0, py::arg("box_yaw") = 0.0)
-      .def_readwrite("position", &PlanarTrack::position, "m")
+      .def_readwrite("position", &PlanarTrack::position, "m, at the measurement stamp")
       .def_readwrite("velocity", &PlanarTrack::velocity, "m/s")
-      .def_readwrite("position_covariance", &PlanarTrack::position_covariance, "m^2")
-      .def_readwrite("velocity_covariance", &PlanarTrack::velocity_covariance, "m^2/s^2")
-      .def_readwrite("size_x", &PlanarTrack::size_x, "m")
+      .def_readwrite("position_covariance", &PlanarTrack::position_covariance, "m² (m² (m^2))")
+      .def_readwrite("velocity_covariance", &PlanarTrack::velocity_covariance,
+                     "m²/s² (m²/s² (m^2/s^2))")
+      .def_readwrite("size_x", &PlanarTrack::size_x, "m, box side along the box's x axis")
       .def_readwrite("size_y", &PlanarTrack::size_y, "m")
-      .def_readwrite("box_yaw", &PlanarTrack::box_yaw, "rad")
+      .def_readwrite("box_yaw", &PlanarTrack::box_yaw, "rad: the box's x axis in the costmap frame")
       .def("validate", &PlanarTrack::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
            "raise).");
@@ -193,20 +202,46 @@ void bindTracking(py::module& m) {
                            "image mode: larger |box coordinates| are rejected (out of range)")
       .def_readonly_static("MAX_POSITION_M", &TrackerConfig::kMaxPositionM,
                            "metric mode: larger |position| / size are rejected (out of range)")
-      .def_readwrite("mode", &TrackerConfig::mode)
-      .def_readwrite("gate_confidence", &TrackerConfig::gate_confidence)
-      .def_readwrite("duplicate_confidence", &TrackerConfig::duplicate_confidence)
-      .def_readwrite("reid_confidence", &TrackerConfig::reid_confidence)
-      .def_readwrite("min_iou", &TrackerConfig::min_iou)
-      .def_readwrite("accel_psd", &TrackerConfig::accel_psd)
-      .def_readwrite("measurement_std", &TrackerConfig::measurement_std)
-      .def_readwrite("initial_velocity_std", &TrackerConfig::initial_velocity_std)
-      .def_readwrite("min_hits", &TrackerConfig::min_hits)
-      .def_readwrite("max_age_s", &TrackerConfig::max_age_s)
-      .def_readwrite("high_score", &TrackerConfig::high_score)
-      .def_readwrite("low_score", &TrackerConfig::low_score)
-      .def_readwrite("second_pass", &TrackerConfig::second_pass)
-      .def_readwrite("class_aware", &TrackerConfig::class_aware)
+      .def_readwrite("mode", &TrackerConfig::mode,
+                     "The member initialisers below are the metric defaults (a default-constructed "
+                     "config is metric, as it always was). Image mode has its own defaults: start "
+                     "from defaultsFor(kImage).")
+      .def_readwrite("gate_confidence", &TrackerConfig::gate_confidence,
+                     "chi-square gate (metric): 2 dof, 0.99 -> 9.21, 0.999 -> 13.8")
+      .def_readwrite(
+          "duplicate_confidence", &TrackerConfig::duplicate_confidence,
+          "Metric mode: a coasting track this close (chi-square gate, 2 dof, sum of both position "
+          "covariances) to a track born while it coasted and updated this frame is its duplicate "
+          "and is removed. 0.9 -> 4.61, about 0.3 m at 0.1 m uncertainty.")
+      .def_readwrite("reid_confidence", &TrackerConfig::reid_confidence,
+                     "Metric mode: a track confirmed this frame takes the id of a track that was "
+                     "already coasting at its birth when their positions agree within this "
+                     "chi-square gate (2 dof, sum of covariances): re-identification after an "
+                     "occlusion the gate could not bridge. 0.99999 -> 23.0.")
+      .def_readwrite("min_iou", &TrackerConfig::min_iou, "image mode: minimum IoU to associate")
+      .def_readwrite(
+          "accel_psd", &TrackerConfig::accel_psd,
+          "Spectral density of the white acceleration noise. Metric: m^2/s^3 per axis. Image: box "
+          "heights^2/s^3 (px^2/s^3 per px^2 of box height), so it scales with the apparent size.")
+      .def_readwrite(
+          "measurement_std", &TrackerConfig::measurement_std,
+          "Metric: m, position noise of detections without a covariance. Image: box heights (std "
+          "of each of centre x, centre y, width and height in px per px of box height).")
+      .def_readwrite("initial_velocity_std", &TrackerConfig::initial_velocity_std,
+                     "m/s (metric) or box heights/s (image)")
+      .def_readwrite("min_hits", &TrackerConfig::min_hits,
+                     "Updates before a track is confirmed; a tentative track that misses one is "
+                     "dropped. Image default 2 (see defaultsFor).")
+      .def_readwrite("max_age_s", &TrackerConfig::max_age_s,
+                     "s a confirmed track coasts without detections (both modes)")
+      .def_readwrite("high_score", &TrackerConfig::high_score,
+                     "detections at or above: first pass, may start tracks")
+      .def_readwrite("low_score", &TrackerConfig::low_score,
+                     "below: ignored; in between: second pass only")
+      .def_readwrite("second_pass", &TrackerConfig::second_pass,
+                     "ByteTrack's low-score association")
+      .def_readwrite("class_aware", &TrackerConfig::class_aware,
+                     "tracks only take detections of their class")
       .def("validate", &TrackerConfig::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
            "raise).")
@@ -219,21 +254,31 @@ void bindTracking(py::module& m) {
   py::class_<TrackerStats>(m, "TrackerStats",
                            "What one tracker step did: detections by kind, matches per pass, "
                            "births, deaths, duplicates, re-identifications.")
-      .def_readonly("detections", &TrackerStats::detections)
-      .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score)
-      .def_readonly("detections_rejected_invalid", &TrackerStats::detections_rejected_invalid)
-      .def_readonly("detections_rejected_out_of_range",
-                    &TrackerStats::detections_rejected_out_of_range)
-      .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass)
-      .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass)
-      .def_readonly("unmatched_outside_gate", &TrackerStats::unmatched_outside_gate)
-      .def_readonly("births", &TrackerStats::births)
-      .def_readonly("deaths", &TrackerStats::deaths)
-      .def_readonly("duplicates_removed", &TrackerStats::duplicates_removed)
-      .def_readonly("reidentified", &TrackerStats::reidentified)
-      .def_readonly("id_switches", &TrackerStats::id_switches)
-      .def_readonly("tracks", &TrackerStats::tracks)
-      .def_readonly("confirmed", &TrackerStats::confirmed);
+      .def_readonly("detections", &TrackerStats::detections, "detections given to step()")
+      .def_readonly("detections_ignored_low_score", &TrackerStats::detections_ignored_low_score,
+                    "scores below low_score")
+      .def_readonly("detections_rejected_invalid", &TrackerStats::detections_rejected_invalid,
+                    "NaN/Inf, boxes with min > max or no area, negative sizes, covariances that "
+                    "are not positive semi-definite")
+      .def_readonly(
+          "detections_rejected_out_of_range", &TrackerStats::detections_rejected_out_of_range,
+          "Finite but beyond TrackerConfig::kMaxBoxCoordinatePx (image) or kMaxPositionM (metric)")
+      .def_readonly("matched_first_pass", &TrackerStats::matched_first_pass,
+                    "high-score detections assigned to a track")
+      .def_readonly("matched_second_pass", &TrackerStats::matched_second_pass,
+                    "low-score detections assigned (ByteTrack's pass)")
+      .def_readonly("unmatched_outside_gate", &TrackerStats::unmatched_outside_gate,
+                    "high-score detections no track could take")
+      .def_readonly("births", &TrackerStats::births, "new tentative tracks")
+      .def_readonly("deaths", &TrackerStats::deaths, "includes duplicates removed")
+      .def_readonly("duplicates_removed", &TrackerStats::duplicates_removed,
+                    "coasting tracks removed as duplicates of new ones")
+      .def_readonly("reidentified", &TrackerStats::reidentified,
+                    "new tracks that took a coasting track's id")
+      .def_readonly("id_switches", &TrackerStats::id_switches,
+                    "truth objects whose track id changed (needs truth ids)")
+      .def_readonly("tracks", &TrackerStats::tracks, "live tracks after the step (every state)")
+      .def_readonly("confirmed", &TrackerStats::confirmed, "of them confirmed or coasting");
   py::class_<Tracker>(m, "Tracker",
                       "SORT-style multi-object tracker (see core/tracking/tracker.h).")
       .def(py::init<const TrackerConfig&>(),

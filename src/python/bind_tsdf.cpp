@@ -75,13 +75,22 @@ void bindOctree(py::module& m) {
       m, "OctreeConfig",
       "Parameters of the OctoMap occupancy octree (metres, probabilities, bytes).")
       .def(py::init<>())
-      .def_readwrite("resolution_m", &OctreeConfig::resolution_m)
-      .def_readwrite("prob_hit", &OctreeConfig::prob_hit)
-      .def_readwrite("prob_miss", &OctreeConfig::prob_miss)
-      .def_readwrite("max_range_m", &OctreeConfig::max_range_m)
-      .def_readwrite("depth_stride_px", &OctreeConfig::depth_stride_px)
-      .def_readwrite("max_distance_m", &OctreeConfig::max_distance_m)
-      .def_readwrite("max_memory_bytes", &OctreeConfig::max_memory_bytes)
+      .def_readwrite("resolution_m", &OctreeConfig::resolution_m, "leaf size, m")
+      .def_readwrite("prob_hit", &OctreeConfig::prob_hit, "log-odds +0.847 per hit")
+      .def_readwrite("prob_miss", &OctreeConfig::prob_miss, "log-odds -0.405 per pass")
+      .def_readwrite("max_range_m", &OctreeConfig::max_range_m, "rays are cut at this range, m")
+      .def_readwrite("depth_stride_px", &OctreeConfig::depth_stride_px,
+                     "depth images: every n-th pixel in each direction is a ray")
+      .def_readwrite("max_distance_m", &OctreeConfig::max_distance_m,
+                     "Memory bounds, the OctoMap's counterparts of the TSDF's (applied by "
+                     "maintain()): leaves farther than this from the sensor are deleted (0 = "
+                     "never; the TSDF node passes its max_block_distance_m); rays are also cut at "
+                     "this range (what lies beyond would go at the next maintenance anyway).")
+      .def_readwrite(
+          "max_memory_bytes", &OctreeConfig::max_memory_bytes,
+          "Cap on memoryBytes() (octomap's count: nodes and child arrays; the heap adds the "
+          "allocator's overhead, about a third more). At the cap maintain() deletes the leaves "
+          "farthest from the sensor until the tree is below 90 % of it (0 = no cap).")
       .def("validate", &OctreeConfig::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
            "raise).");
@@ -96,12 +105,12 @@ void bindOctree(py::module& m) {
            }),
            py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"),
            py::arg("height"))
-      .def_readonly("fx", &PinholeCamera::fx)
-      .def_readonly("fy", &PinholeCamera::fy)
-      .def_readonly("cx", &PinholeCamera::cx)
-      .def_readonly("cy", &PinholeCamera::cy)
-      .def_readonly("width", &PinholeCamera::width)
-      .def_readonly("height", &PinholeCamera::height);
+      .def_readonly("fx", &PinholeCamera::fx, "focal length along x, px")
+      .def_readonly("fy", &PinholeCamera::fy, "focal length along y, px")
+      .def_readonly("cx", &PinholeCamera::cx, "principal point x, px (pixel centres at integers)")
+      .def_readonly("cy", &PinholeCamera::cy, "principal point y, px")
+      .def_readonly("width", &PinholeCamera::width, "image width, px")
+      .def_readonly("height", &PinholeCamera::height, "image height, px");
   py::class_<OccupancyOctree>(m, "OccupancyOctree",
                               "OctoMap occupancy (octomap::OcTree) from the same observations.")
       .def(py::init<const OctreeConfig&>(), py::arg_v("config", OctreeConfig{}, "OctreeConfig()"))
@@ -187,9 +196,11 @@ void bindOctree(py::module& m) {
           py::arg("sensor_origin"),
           "Applies the config's max_distance_m and max_memory_bytes around the sensor and prunes; "
           "returns what it deleted and the size after.")
-      .def_property_readonly("node_count", &OccupancyOctree::nodeCount)
-      .def_property_readonly("leaf_count", &OccupancyOctree::leafCount)
-      .def_property_readonly("memory_bytes", &OccupancyOctree::memoryBytes)
+      .def_property_readonly("node_count", &OccupancyOctree::nodeCount, "nodes in the tree")
+      .def_property_readonly("leaf_count", &OccupancyOctree::leafCount, "leaves in the tree")
+      .def_property_readonly(
+          "memory_bytes", &OccupancyOctree::memoryBytes,
+          "bytes (octomap's count for the OctoMap; the blocks' chunks for the TSDF)")
       .def("clear", &OccupancyOctree::clear, "Forgets every node.");
 }
 
@@ -202,21 +213,62 @@ void bindTsdf(py::module& m) {
                          "Parameters of the sparse TSDF (voxel size and truncation in metres, "
                          "weights, memory bounds).")
       .def(py::init<>())
-      .def_readwrite("voxel_size_m", &TsdfConfig::voxel_size_m)
-      .def_readwrite("truncation_voxels", &TsdfConfig::truncation_voxels)
-      .def_readwrite("max_weight", &TsdfConfig::max_weight)
-      .def_readwrite("weighting", &TsdfConfig::weighting)
-      .def_readwrite("behind_surface_dropoff", &TsdfConfig::behind_surface_dropoff)
-      .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad)
-      .def_readwrite("interpolate_depth", &TsdfConfig::interpolate_depth)
-      .def_readwrite("carve_free_space", &TsdfConfig::carve_free_space)
-      .def_readwrite("no_return_carve_min_valid_fraction",
-                     &TsdfConfig::no_return_carve_min_valid_fraction)
-      .def_readwrite("min_depth_m", &TsdfConfig::min_depth_m)
-      .def_readwrite("max_depth_m", &TsdfConfig::max_depth_m)
-      .def_readwrite("min_weight", &TsdfConfig::min_weight)
-      .def_readwrite("max_blocks", &TsdfConfig::max_blocks)
-      .def_readwrite("max_block_distance_m", &TsdfConfig::max_block_distance_m)
+      .def_readwrite("voxel_size_m", &TsdfConfig::voxel_size_m,
+                     "voxel edge, m; fixed for the map's life")
+      .def_readwrite(
+          "truncation_voxels", &TsdfConfig::truncation_voxels,
+          "Truncation distance mu in voxels (mu = truncation_voxels * voxel_size_m); 3-5 is usual.")
+      .def_readwrite(
+          "max_weight", &TsdfConfig::max_weight,
+          "Cap on the fused weight, so the map keeps following a changing scene (0 = no cap).")
+      .def_readwrite("weighting", &TsdfConfig::weighting, "weight of one observation")
+      .def_readwrite("behind_surface_dropoff", &TsdfConfig::behind_surface_dropoff,
+                     "Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at "
+                     "-mu, so a surface seen from one side does not write a deep negative shell "
+                     "that ghosts when seen from the other side (voxblox's weight drop-off).")
+      .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad,
+                     "Depth images: voxels more than a voxel behind the surface seen by a pixel "
+                     "within this angle (rad) of a depth edge (a jump of more than mu) are not "
+                     "updated. Rays grazing an object's rim would otherwise write \"inside\" "
+                     "values into the free space beyond its edges (the projective TSDF's ghost "
+                     "surfaces). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.")
+      .def_readwrite(
+          "interpolate_depth", &TsdfConfig::interpolate_depth,
+          "Depth images: read each voxel's depth by interpolating inverse depth between the four "
+          "nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the "
+          "nearest pixel across depth edges (neighbours differing by more than one voxel).")
+      .def_readwrite(
+          "carve_free_space", &TsdfConfig::carve_free_space,
+          "Update the voxels along the whole ray from the sensor, not only the truncation band: an "
+          "object that moved away is erased where its free space is seen again (voxblox's voxel "
+          "carving). Off by default: it allocates blocks for all the free space in view, so memory "
+          "and time grow with the range. Carving stays inside the camera's view frustum up to "
+          "max_depth_m (PinholeCamera::validate refuses intrinsics whose frustum is absurdly wide "
+          "or off-axis).")
+      .def_readwrite(
+          "no_return_carve_min_valid_fraction", &TsdfConfig::no_return_carve_min_valid_fraction,
+          "With carve_free_space, a +Inf pixel (\"no return within range\", REP 118) carves its "
+          "ray up to max_depth_m only in a frame where at least this fraction of all pixels are "
+          "valid depths: the returns are the evidence that the sensor works and the pose is right. "
+          "In other frames its +Inf pixels are ignored like invalid ones (and counted): one frame "
+          "without any return (a covered or failing sensor) would otherwise carve through every "
+          "wall in view. 0 = +Inf always carves; 1 = only frames without any invalid or +Inf pixel "
+          "(so +Inf never carves). Without carving, +Inf pixels only free voxels of blocks the "
+          "frame's returns allocate.")
+      .def_readwrite("min_depth_m", &TsdfConfig::min_depth_m, "closer depths are invalid")
+      .def_readwrite("max_depth_m", &TsdfConfig::max_depth_m,
+                     "farther depths are invalid (at most 1000 m)")
+      .def_readwrite(
+          "min_weight", &TsdfConfig::min_weight,
+          "Voxels whose weight is below this are \"unobserved\" for meshing and queries.")
+      .def_readwrite(
+          "max_blocks", &TsdfConfig::max_blocks,
+          "Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig) "
+          "evicts blocks down to the new cap at once: the least recently updated first, among "
+          "equally recent ones the farthest from the last sensor origin.")
+      .def_readwrite("max_block_distance_m", &TsdfConfig::max_block_distance_m,
+                     "Blocks whose centre is farther than this from the last sensor origin are "
+                     "evicted after each integration (0 = never).")
       .def("truncation", &TsdfConfig::truncation, "mu in metres")
       .def("validate", &TsdfConfig::validate,
            "Empty string if the configuration is valid, else the reason (what the constructors "
@@ -224,27 +276,37 @@ void bindTsdf(py::module& m) {
   py::class_<TsdfIntegrationStats>(m, "TsdfIntegrationStats",
                                    "What one TSDF integration did: pixels by kind, blocks touched, "
                                    "allocated, refused, evicted, voxels updated.")
-      .def_readonly("pixels_valid", &TsdfIntegrationStats::pixels_valid)
-      .def_readonly("pixels_invalid", &TsdfIntegrationStats::pixels_invalid)
-      .def_readonly("pixels_no_return", &TsdfIntegrationStats::pixels_no_return)
-      .def_readonly("pixels_no_return_ignored", &TsdfIntegrationStats::pixels_no_return_ignored)
+      .def_readonly("pixels_valid", &TsdfIntegrationStats::pixels_valid, "depths (or points) used")
+      .def_readonly("pixels_invalid", &TsdfIntegrationStats::pixels_invalid,
+                    "NaN, 0, negative or outside [min_depth_m, max_depth_m]")
+      .def_readonly("pixels_no_return", &TsdfIntegrationStats::pixels_no_return,
+                    "+Inf (REP-118: nothing within range)")
+      .def_readonly("pixels_no_return_ignored", &TsdfIntegrationStats::pixels_no_return_ignored,
+                    "+Inf pixels ignored: carving, in a frame with too few valid depths "
+                    "(no_return_carve_min_valid_fraction); also counted in pixels_no_return.")
       .def_property_readonly(
           "refused",
           [](const TsdfIntegrationStats& s) -> py::object {
             return s.refused == nullptr ? py::object(py::none()) : py::str(s.refused);
           },
           "Why the whole frame was refused (its pixels counted invalid), or None.")
-      .def_readonly("blocks_touched", &TsdfIntegrationStats::blocks_touched)
-      .def_readonly("blocks_allocated", &TsdfIntegrationStats::blocks_allocated)
-      .def_readonly("blocks_refused", &TsdfIntegrationStats::blocks_refused)
-      .def_readonly("blocks_evicted", &TsdfIntegrationStats::blocks_evicted)
-      .def_readonly("voxels_updated", &TsdfIntegrationStats::voxels_updated);
+      .def_readonly("blocks_touched", &TsdfIntegrationStats::blocks_touched,
+                    "blocks the frame's truncation band (or rays) reached")
+      .def_readonly("blocks_allocated", &TsdfIntegrationStats::blocks_allocated,
+                    "of them new this frame")
+      .def_readonly("blocks_refused", &TsdfIntegrationStats::blocks_refused,
+                    "not allocated: max_blocks reached (>= 1 if so)")
+      .def_readonly("blocks_evicted", &TsdfIntegrationStats::blocks_evicted,
+                    "farther than max_block_distance_m")
+      .def_readonly("voxels_updated", &TsdfIntegrationStats::voxels_updated,
+                    "voxels fused this frame");
 
   py::class_<Tsdf>(m, "Tsdf",
                    "Sparse TSDF (8^3-voxel blocks) with an incremental marching-cubes mesher.")
       .def(py::init([](const TsdfConfig& c) { return std::make_unique<Tsdf>(c); }),
            py::arg_v("config", TsdfConfig{}, "TsdfConfig()"))
-      .def_property_readonly("config", [](const Tsdf& t) { return t.map.config(); })
+      .def_property_readonly(
+          "config", [](const Tsdf& t) { return t.map.config(); }, "the configuration in use")
       .def(
           "set_config",
           [](Tsdf& self, const TsdfConfig& c) {
@@ -363,8 +425,12 @@ void bindTsdf(py::module& m) {
           },
           "The lesson's health check: at zero crossings |grad (D mu)| (1 = clean), the share "
           "below 0.5, and double crossings within mu (pose drift's fingerprint).")
-      .def_property_readonly("block_count", [](const Tsdf& t) { return t.map.blockCount(); })
-      .def_property_readonly("memory_bytes", [](const Tsdf& t) { return t.map.memoryBytes(); })
+      .def_property_readonly(
+          "block_count", [](const Tsdf& t) { return t.map.blockCount(); },
+          "allocated 8^3-voxel blocks")
+      .def_property_readonly(
+          "memory_bytes", [](const Tsdf& t) { return t.map.memoryBytes(); },
+          "bytes (octomap's count for the OctoMap; the blocks' chunks for the TSDF)")
       .def_property_readonly(
           "blocks_evicted_to_cap", [](const Tsdf& t) { return t.map.blocksEvictedToCap(); },
           "Blocks evicted because set_config lowered max_blocks below the block count (total).")

@@ -80,50 +80,105 @@ void bindVoxel(py::module& m) {
   py::class_<VoxelMapConfig>(m, "VoxelMapConfig",
                              "3-D voxel obstacle map settings (costmap_2d VoxelLayer's meaning).")
       .def(py::init<>())
-      .def_readwrite("resolution_m", &VoxelMapConfig::resolution_m, "voxel edge in x, y (m)")
-      .def_readwrite("z_resolution_m", &VoxelMapConfig::z_resolution_m, "voxel height (m)")
-      .def_readwrite("origin_z_m", &VoxelMapConfig::origin_z_m, "bottom of voxel layer 0 (m)")
-      .def_readwrite("z_voxels", &VoxelMapConfig::z_voxels, "voxels per column")
+      .def_readwrite("resolution_m", &VoxelMapConfig::resolution_m,
+                     "Edge of a voxel in x and y, m (the layer uses the costmap's resolution). "
+                     "Default 0.05. (Edge of a voxel in x and y, m (the layer uses the costmap's "
+                     "resolution). Default 0.05. (voxel edge in x, y (m)))")
+      .def_readwrite(
+          "z_resolution_m", &VoxelMapConfig::z_resolution_m,
+          "Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (Height of a "
+          "voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (voxel height (m)))")
+      .def_readwrite("origin_z_m", &VoxelMapConfig::origin_z_m,
+                     "Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0. "
+                     "(Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default "
+                     "0. (bottom of voxel layer 0 (m)))")
+      .def_readwrite("z_voxels", &VoxelMapConfig::z_voxels,
+                     "Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most "
+                     "kMaxZVoxels). Default 10. (Voxels per column (costmap_2d `z_voxels`, there "
+                     "at most 16; here at most kMaxZVoxels). Default 10. (voxels per column))")
       .def_readwrite("mark_threshold", &VoxelMapConfig::mark_threshold,
-                     "a column with more occupied band voxels than this is lethal")
-      .def_readwrite("unknown_threshold", &VoxelMapConfig::unknown_threshold,
-                     "a column with at most this many unknown band voxels is known")
-      .def_readwrite("min_obstacle_height_m", &VoxelMapConfig::min_obstacle_height_m)
-      .def_readwrite("max_obstacle_height_m", &VoxelMapConfig::max_obstacle_height_m)
-      .def_readwrite("log_odds", &VoxelMapConfig::log_odds)
-      .def_readwrite("decay_time_s", &VoxelMapConfig::decay_time_s, "0 = no decay")
-      .def_readwrite("max_memory_mib", &VoxelMapConfig::max_memory_mib)
+                     "A column with MORE than this many occupied voxels in the height band is "
+                     "lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. "
+                     "(A column with MORE than this many occupied voxels in the height band is "
+                     "lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. "
+                     "(a column with more occupied band voxels than this is lethal))")
+      .def_readwrite(
+          "unknown_threshold", &VoxelMapConfig::unknown_threshold,
+          "A column with AT MOST this many unknown voxels in the band is known; a known column "
+          "that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). "
+          "Default 15 (with 10 voxels: every column counts as known, as in costmap_2d). (A column "
+          "with AT MOST this many unknown voxels in the band is known; a known column that is not "
+          "lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with "
+          "10 voxels: every column counts as known, as in costmap_2d). (a column with at most this "
+          "many unknown band voxels is known))")
+      .def_readwrite("min_obstacle_height_m", &VoxelMapConfig::min_obstacle_height_m,
+                     "The robot's height band, m: only voxels whose centre lies in [min, max] are "
+                     "projected into the 2-D costmap (an overhang above the robot is kept in 3-D "
+                     "but ignored). Defaults 0 and 2.")
+      .def_readwrite("max_obstacle_height_m", &VoxelMapConfig::max_obstacle_height_m,
+                     "top of the band projected into the costmap, m")
+      .def_readwrite("log_odds", &VoxelMapConfig::log_odds,
+                     "Inverse sensor model per voxel. Defaults: p_hit 0.7 (+0.847), p_miss 0.4 "
+                     "(-0.405), clamp [-2, 3.5] (octomap's 0.12 / 0.97), occupied above 0.5 (one "
+                     "hit marks, as in costmap_2d), free below -0.3 (one miss frees).")
+      .def_readwrite("decay_time_s", &VoxelMapConfig::decay_time_s,
+                     "Time constant of the decay toward unknown, s: evidence is multiplied by "
+                     "exp(-dt / tau) for the time dt since the voxel's last update. 0 = no decay "
+                     "(costmap_2d has none). Default 0.")
+      .def_readwrite("max_memory_mib", &VoxelMapConfig::max_memory_mib,
+                     "Memory bound for the voxel blocks, MiB. Updates that would need a block "
+                     "beyond it are dropped and counted. Default 64.")
       .def("validate", &VoxelMapConfig::validate, "Empty string if valid, else the reason.");
 
   py::class_<VoxelRayConfig>(m, "VoxelRayConfig", "How far a source's rays mark and clear.")
       .def(py::init<>())
-      .def_readwrite("obstacle_max_range_m", &VoxelRayConfig::obstacle_max_range_m)
-      .def_readwrite("raytrace_max_range_m", &VoxelRayConfig::raytrace_max_range_m)
-      .def_readwrite("no_return_range_m", &VoxelRayConfig::no_return_range_m)
-      .def_readwrite("marking", &VoxelRayConfig::marking)
-      .def_readwrite("clearing", &VoxelRayConfig::clearing)
-      .def_readwrite("one_ray_per_end_voxel", &VoxelRayConfig::one_ray_per_end_voxel,
-                     "cast only the first ray of a frame ending in each voxel")
+      .def_readwrite("obstacle_max_range_m", &VoxelRayConfig::obstacle_max_range_m,
+                     "returns farther than this do not mark (3-D distance)")
+      .def_readwrite("raytrace_max_range_m", &VoxelRayConfig::raytrace_max_range_m,
+                     "rays clear at most this far, m")
+      .def_readwrite("no_return_range_m", &VoxelRayConfig::no_return_range_m,
+                     "a no-return ray clears this far, m")
+      .def_readwrite("marking", &VoxelRayConfig::marking, "returns mark their voxel")
+      .def_readwrite("clearing", &VoxelRayConfig::clearing, "rays clear the voxels they cross")
+      .def_readwrite(
+          "one_ray_per_end_voxel", &VoxelRayConfig::one_ray_per_end_voxel,
+          "Of the rays of a frame that end in the same voxel, cast only the first (every return "
+          "still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped "
+          "ray (beside the cast one, near the end, where rays to one voxel diverge by less than a "
+          "voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth "
+          "image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, "
+          "costmap_2d's behaviour). (Of the rays of a frame that end in the same voxel, cast only "
+          "the first (every return still marks). Each cast ray is still walked exactly; a voxel "
+          "crossed only by a skipped ray (beside the cast one, near the end, where rays to one "
+          "voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far "
+          "fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false "
+          "(every ray exact, costmap_2d's behaviour). (cast only the first ray of a frame ending "
+          "in each voxel))")
       .def("validate", &VoxelRayConfig::validate, "Empty string if valid, else the reason.");
 
   py::class_<VoxelMap>(m, "VoxelMap", "Sparse 3-D log-odds voxels over a rolling window.")
       .def(py::init<const VoxelMapConfig&, double, double, int, int>(), py::arg("config"),
            py::arg("anchor_x_m"), py::arg("anchor_y_m"), py::arg("nx"), py::arg("ny"),
            "Raises ValueError for an invalid config, anchor or window size.")
-      .def_property_readonly("config", &VoxelMap::config)
+      .def_property_readonly("config", &VoxelMap::config, "the configuration in use")
       .def_property_readonly(
-          "shape", [](const VoxelMap& s) { return py::make_tuple(s.nx(), s.ny(), s.nz()); })
+          "shape", [](const VoxelMap& s) { return py::make_tuple(s.nx(), s.ny(), s.nz()); },
+          "(nx, ny, nz) voxels of the window")
       .def_property_readonly(
           "window_offset",
-          [](const VoxelMap& s) { return py::make_tuple(s.windowX0(), s.windowY0()); })
+          [](const VoxelMap& s) { return py::make_tuple(s.windowX0(), s.windowY0()); },
+          "(x, y) index of the window's first column on the map's lattice")
       .def_property_readonly(
           "window_origin",
-          [](const VoxelMap& s) { return py::make_tuple(s.windowOriginX(), s.windowOriginY()); })
+          [](const VoxelMap& s) { return py::make_tuple(s.windowOriginX(), s.windowOriginY()); },
+          "(x, y) of the window's lower-left corner, m")
       .def_property_readonly(
-          "band", [](const VoxelMap& s) { return py::make_tuple(s.bandFirst(), s.bandLast()); })
-      .def_property_readonly("blocks", &VoxelMap::blocks)
-      .def_property_readonly("max_blocks", &VoxelMap::maxBlocks)
-      .def_property_readonly("memory_bytes", &VoxelMap::memoryBytes)
+          "band", [](const VoxelMap& s) { return py::make_tuple(s.bandFirst(), s.bandLast()); },
+          "(first, last) voxel layers inside the height band")
+      .def_property_readonly("blocks", &VoxelMap::blocks, "allocated 8^3-voxel blocks")
+      .def_property_readonly("max_blocks", &VoxelMap::maxBlocks, "blocks allowed by max_memory_mib")
+      .def_property_readonly("memory_bytes", &VoxelMap::memoryBytes,
+                             "bytes held by blocks and the block table")
       .def("set_window", &VoxelMap::setWindow, py::arg("x0"), py::arg("y0"), py::arg("nx"),
            py::arg("ny"),
            "Moves / resizes the window to nx x ny columns from column (x0, y0) (voxel indices); "

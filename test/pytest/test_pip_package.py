@@ -90,3 +90,23 @@ def test_the_package_exports_every_public_entry_point() -> None:
 
     hidden = sorted(n for n in _public_names() if n != "pybind11_version" and n not in vars(dp))
     assert hidden == [], f"add {hidden} to the import list in downstream_perception/__init__.py"
+
+
+def test_every_field_has_a_docstring() -> None:
+    # help(dp.TsdfConfig) is where a Python user reads what a field means and its unit: each
+    # field carries its C++ header comment.
+    undocumented = []
+    for name in sorted(_public_names()):
+        obj = getattr(core, name)
+        if not isinstance(obj, type):
+            continue
+        for member_name, member in vars(obj).items():
+            if member_name.startswith("_") or not isinstance(member, property):
+                continue
+            # pybind11 keeps no docstring on class-level constants (static properties), and an
+            # enum's `value` is pybind11's own.
+            if type(member).__name__ == "pybind11_static_property" or member_name == "value":
+                continue
+            if not (member.__doc__ or "").strip():
+                undocumented.append(f"{name}.{member_name}")
+    assert undocumented == []

@@ -114,8 +114,8 @@ struct ScanIntegratorConfig {
   /// value is a typo, and ranges of ~1e15 m put beam ends where a double cannot place them.
   static constexpr double kMaxRangeM = 1e4;
 
-  bool marking = true;
-  bool clearing = true;
+  bool marking = true;                  ///< returns mark their cell
+  bool clearing = true;                 ///< beams clear the cells they cross
   double obstacle_min_range = 0.0;      ///< m: returns nearer than this do not mark
   double obstacle_max_range = 2.5;      ///< m: returns farther than this do not mark
   double raytrace_min_range = 0.0;      ///< m: clearing starts this far from the sensor

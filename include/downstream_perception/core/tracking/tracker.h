@@ -125,23 +125,23 @@ struct Track {
 };
 
 struct TrackerStats {
-  std::size_t detections = 0;
-  std::size_t detections_ignored_low_score = 0;
+  std::size_t detections = 0;                    ///< detections given to step()
+  std::size_t detections_ignored_low_score = 0;  ///< scores below low_score
   /// NaN/Inf, boxes with min > max or no area, negative sizes, covariances that are not
   /// positive semi-definite
   std::size_t detections_rejected_invalid = 0;
   /// Finite but beyond TrackerConfig::kMaxBoxCoordinatePx (image) or kMaxPositionM (metric)
   std::size_t detections_rejected_out_of_range = 0;
-  std::size_t matched_first_pass = 0;
-  std::size_t matched_second_pass = 0;
+  std::size_t matched_first_pass = 0;      ///< high-score detections assigned to a track
+  std::size_t matched_second_pass = 0;     ///< low-score detections assigned (ByteTrack's pass)
   std::size_t unmatched_outside_gate = 0;  ///< high-score detections no track could take
-  std::size_t births = 0;
-  std::size_t deaths = 0;  ///< includes duplicates removed
-  std::size_t duplicates_removed = 0;
-  std::size_t reidentified = 0;  ///< new tracks that took a coasting track's id
-  std::size_t id_switches = 0;   ///< truth objects whose track id changed (needs truth ids)
-  std::size_t tracks = 0;
-  std::size_t confirmed = 0;
+  std::size_t births = 0;                  ///< new tentative tracks
+  std::size_t deaths = 0;                  ///< includes duplicates removed
+  std::size_t duplicates_removed = 0;      ///< coasting tracks removed as duplicates of new ones
+  std::size_t reidentified = 0;            ///< new tracks that took a coasting track's id
+  std::size_t id_switches = 0;  ///< truth objects whose track id changed (needs truth ids)
+  std::size_t tracks = 0;       ///< live tracks after the step (every state)
+  std::size_t confirmed = 0;    ///< of them confirmed or coasting
   void accumulate(const TrackerStats& o);
 };
 

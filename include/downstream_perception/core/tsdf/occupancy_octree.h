@@ -21,11 +21,11 @@ class OcTree;
 namespace downstream_perception {
 
 struct OctreeConfig {
-  double resolution_m = 0.05;
-  double prob_hit = 0.7;   ///< log-odds +0.847 per hit
-  double prob_miss = 0.4;  ///< log-odds -0.405 per pass
-  double max_range_m = 10.0;
-  int depth_stride_px = 4;  ///< depth images: every n-th pixel in each direction is a ray
+  double resolution_m = 0.05;  ///< leaf size, m
+  double prob_hit = 0.7;       ///< log-odds +0.847 per hit
+  double prob_miss = 0.4;      ///< log-odds -0.405 per pass
+  double max_range_m = 10.0;   ///< rays are cut at this range, m
+  int depth_stride_px = 4;     ///< depth images: every n-th pixel in each direction is a ray
   /// Memory bounds, the OctoMap's counterparts of the TSDF's (applied by maintain()):
   /// leaves farther than this from the sensor are deleted (0 = never; the TSDF node passes its
   /// max_block_distance_m); rays are also cut at this range (what lies beyond would go at the

@@ -24,12 +24,12 @@ constexpr double kMaxViewTangent = 10.0;
 /// Pinhole intrinsics of a depth image in the ROS optical convention (z forward, x right,
 /// y down; pixel (u, v) has its centre at integer coordinates, as in CameraInfo's K).
 struct PinholeCamera {
-  double fx = 0.0;
-  double fy = 0.0;
-  double cx = 0.0;
-  double cy = 0.0;
-  int width = 0;
-  int height = 0;
+  double fx = 0.0;  ///< focal length along x, px
+  double fy = 0.0;  ///< focal length along y, px
+  double cx = 0.0;  ///< principal point x, px (pixel centres at integers)
+  double cy = 0.0;  ///< principal point y, px
+  int width = 0;    ///< image width, px
+  int height = 0;   ///< image height, px
   /// Empty if valid, else the reason.
   std::string validate() const;
 };
@@ -41,11 +41,11 @@ struct TsdfIntegrationStats {
   /// +Inf pixels ignored: carving, in a frame with too few valid depths
   /// (no_return_carve_min_valid_fraction); also counted in pixels_no_return.
   std::size_t pixels_no_return_ignored = 0;
-  std::size_t blocks_touched = 0;
-  std::size_t blocks_allocated = 0;
-  std::size_t blocks_refused = 0;  ///< not allocated: max_blocks reached (>= 1 if so)
-  std::size_t blocks_evicted = 0;  ///< farther than max_block_distance_m
-  std::size_t voxels_updated = 0;
+  std::size_t blocks_touched = 0;    ///< blocks the frame's truncation band (or rays) reached
+  std::size_t blocks_allocated = 0;  ///< of them new this frame
+  std::size_t blocks_refused = 0;    ///< not allocated: max_blocks reached (>= 1 if so)
+  std::size_t blocks_evicted = 0;    ///< farther than max_block_distance_m
+  std::size_t voxels_updated = 0;    ///< voxels fused this frame
   /// Why the whole frame was refused (all its pixels or points counted invalid), or nullptr:
   /// invalid intrinsics, a pose or sensor origin not finite or beyond TsdfMap::inBounds.
   const char* refused = nullptr;

@@ -25,7 +25,7 @@
 namespace downstream_perception {
 
 struct TsdfConfig {
-  double voxel_size_m = 0.02;
+  double voxel_size_m = 0.02;  ///< voxel edge, m; fixed for the map's life
   /// Truncation distance mu in voxels (mu = truncation_voxels * voxel_size_m); 3-5 is usual.
   double truncation_voxels = 4.0;
   /// Cap on the fused weight, so the map keeps following a changing scene (0 = no cap).
@@ -34,7 +34,7 @@ struct TsdfConfig {
     kConstant,           ///< w = 1 per observation (Open3D, KinectFusion)
     kInverseSquareDepth  ///< w = 1 / z^2 (z in m): far, noisier depths count less
   };
-  Weighting weighting = Weighting::kConstant;
+  Weighting weighting = Weighting::kConstant;  ///< weight of one observation
   /// Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at -mu, so a
   /// surface seen from one side does not write a deep negative shell that ghosts when seen from
   /// the other side (voxblox's weight drop-off).

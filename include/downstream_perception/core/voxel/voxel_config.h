@@ -30,7 +30,7 @@ struct VoxelMapConfig {
   /// The robot's height band, m: only voxels whose centre lies in [min, max] are projected into
   /// the 2-D costmap (an overhang above the robot is kept in 3-D but ignored). Defaults 0 and 2.
   double min_obstacle_height_m = 0.0;
-  double max_obstacle_height_m = 2.0;
+  double max_obstacle_height_m = 2.0;  ///< top of the band projected into the costmap, m
   /// Inverse sensor model per voxel. Defaults: p_hit 0.7 (+0.847), p_miss 0.4 (-0.405), clamp
   /// [-2, 3.5] (octomap's 0.12 / 0.97), occupied above 0.5 (one hit marks, as in costmap_2d),
   /// free below -0.3 (one miss frees).
@@ -56,8 +56,8 @@ struct VoxelRayConfig {
   double obstacle_max_range_m = 2.5;  ///< returns farther than this do not mark (3-D distance)
   double raytrace_max_range_m = 3.0;  ///< rays clear at most this far, m
   double no_return_range_m = 3.0;     ///< a no-return ray clears this far, m
-  bool marking = true;
-  bool clearing = true;
+  bool marking = true;                ///< returns mark their voxel
+  bool clearing = true;               ///< rays clear the voxels they cross
   /// Of the rays of a frame that end in the same voxel, cast only the first (every return still
   /// marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside
   /// the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not
