@@ -113,15 +113,30 @@ class GridGeometry:
         Cell (x, y) containing the point, by floor; may lie outside the grid.
         """
     @property
-    def origin_x(self) -> float: ...
+    def origin_x(self) -> float:
+        """
+        x of the lower-left corner, m
+        """
     @property
-    def origin_y(self) -> float: ...
+    def origin_y(self) -> float:
+        """
+        y of the lower-left corner, m
+        """
     @property
-    def resolution(self) -> float: ...
+    def resolution(self) -> float:
+        """
+        cell edge, m
+        """
     @property
-    def size_x(self) -> int: ...
+    def size_x(self) -> int:
+        """
+        cells along x
+        """
     @property
-    def size_y(self) -> int: ...
+    def size_y(self) -> int:
+        """
+        cells along y
+        """
 
 class Pose2D:
     """
@@ -139,15 +154,24 @@ class Pose2D:
         (x, y, yaw) as a tuple.
         """
     @property
-    def x(self) -> float: ...
+    def x(self) -> float:
+        """
+        m
+        """
     @x.setter
     def x(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def y(self) -> float: ...
+    def y(self) -> float:
+        """
+        m
+        """
     @y.setter
     def y(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def yaw(self) -> float: ...
+    def yaw(self) -> float:
+        """
+        rad, counter-clockwise from x
+        """
     @yaw.setter
     def yaw(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
@@ -161,31 +185,52 @@ class OctreeConfig:
         Empty string if the configuration is valid, else the reason (what the constructors raise).
         """
     @property
-    def depth_stride_px(self) -> int: ...
+    def depth_stride_px(self) -> int:
+        """
+        depth images: every n-th pixel in each direction is a ray
+        """
     @depth_stride_px.setter
     def depth_stride_px(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
-    def max_distance_m(self) -> float: ...
+    def max_distance_m(self) -> float:
+        """
+        Memory bounds, the OctoMap's counterparts of the TSDF's (applied by maintain()): leaves farther than this from the sensor are deleted (0 = never; the TSDF node passes its max_block_distance_m); rays are also cut at this range (what lies beyond would go at the next maintenance anyway).
+        """
     @max_distance_m.setter
     def max_distance_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def max_memory_bytes(self) -> int: ...
+    def max_memory_bytes(self) -> int:
+        """
+        Cap on memoryBytes() (octomap's count: nodes and child arrays; the heap adds the allocator's overhead, about a third more). At the cap maintain() deletes the leaves farthest from the sensor until the tree is below 90 % of it (0 = no cap).
+        """
     @max_memory_bytes.setter
     def max_memory_bytes(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
-    def max_range_m(self) -> float: ...
+    def max_range_m(self) -> float:
+        """
+        rays are cut at this range, m
+        """
     @max_range_m.setter
     def max_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def prob_hit(self) -> float: ...
+    def prob_hit(self) -> float:
+        """
+        log-odds +0.847 per hit
+        """
     @prob_hit.setter
     def prob_hit(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def prob_miss(self) -> float: ...
+    def prob_miss(self) -> float:
+        """
+        log-odds -0.405 per pass
+        """
     @prob_miss.setter
     def prob_miss(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def resolution_m(self) -> float: ...
+    def resolution_m(self) -> float:
+        """
+        leaf size, m
+        """
     @resolution_m.setter
     def resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
@@ -203,17 +248,35 @@ class PinholeCamera:
         height: typing.SupportsInt | typing.SupportsIndex,
     ) -> None: ...
     @property
-    def cx(self) -> float: ...
+    def cx(self) -> float:
+        """
+        principal point x, px (pixel centres at integers)
+        """
     @property
-    def cy(self) -> float: ...
+    def cy(self) -> float:
+        """
+        principal point y, px
+        """
     @property
-    def fx(self) -> float: ...
+    def fx(self) -> float:
+        """
+        focal length along x, px
+        """
     @property
-    def fy(self) -> float: ...
+    def fy(self) -> float:
+        """
+        focal length along y, px
+        """
     @property
-    def height(self) -> int: ...
+    def height(self) -> int:
+        """
+        image height, px
+        """
     @property
-    def width(self) -> int: ...
+    def width(self) -> int:
+        """
+        image width, px
+        """
 
 class OccupancyOctree:
     """
@@ -270,11 +333,20 @@ class OccupancyOctree:
         Writes the octree as an OctoMap .bt file (refuses to overwrite unless asked).
         """
     @property
-    def leaf_count(self) -> int: ...
+    def leaf_count(self) -> int:
+        """
+        leaves in the tree
+        """
     @property
-    def memory_bytes(self) -> int: ...
+    def memory_bytes(self) -> int:
+        """
+        bytes (octomap's count for the OctoMap; the blocks' chunks for the TSDF)
+        """
     @property
-    def node_count(self) -> int: ...
+    def node_count(self) -> int:
+        """
+        nodes in the tree
+        """
 
 class TsdfWeighting:
     """
@@ -313,11 +385,6 @@ class TsdfConfig:
     """
     Parameters of the sparse TSDF (voxel size and truncation in metres, weights, memory bounds).
     """
-
-    behind_surface_dropoff: bool
-    carve_free_space: bool
-    interpolate_depth: bool
-    weighting: TsdfWeighting
     def __init__(self) -> None: ...
     def truncation(self) -> float:
         """
@@ -328,75 +395,160 @@ class TsdfConfig:
         Empty string if the configuration is valid, else the reason (what the constructors raise).
         """
     @property
-    def edge_guard_rad(self) -> float: ...
+    def behind_surface_dropoff(self) -> bool:
+        """
+        Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at -mu, so a surface seen from one side does not write a deep negative shell that ghosts when seen from the other side (voxblox's weight drop-off).
+        """
+    @behind_surface_dropoff.setter
+    def behind_surface_dropoff(self, arg0: bool) -> None: ...
+    @property
+    def carve_free_space(self) -> bool:
+        """
+        Update the voxels along the whole ray from the sensor, not only the truncation band: an object that moved away is erased where its free space is seen again (voxblox's voxel carving). Off by default: it allocates blocks for all the free space in view, so memory and time grow with the range. Carving stays inside the camera's view frustum up to max_depth_m (PinholeCamera::validate refuses intrinsics whose frustum is absurdly wide or off-axis).
+        """
+    @carve_free_space.setter
+    def carve_free_space(self, arg0: bool) -> None: ...
+    @property
+    def edge_guard_rad(self) -> float:
+        """
+        Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle (rad) of a depth edge (a jump of more than mu) are not updated. Rays grazing an object's rim would otherwise write "inside" values into the free space beyond its edges (the projective TSDF's ghost surfaces). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.
+        """
     @edge_guard_rad.setter
     def edge_guard_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def max_block_distance_m(self) -> float: ...
+    def interpolate_depth(self) -> bool:
+        """
+        Depth images: read each voxel's depth by interpolating inverse depth between the four nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the nearest pixel across depth edges (neighbours differing by more than one voxel).
+        """
+    @interpolate_depth.setter
+    def interpolate_depth(self, arg0: bool) -> None: ...
+    @property
+    def max_block_distance_m(self) -> float:
+        """
+        Blocks whose centre is farther than this from the last sensor origin are evicted after each integration (0 = never).
+        """
     @max_block_distance_m.setter
     def max_block_distance_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def max_blocks(self) -> int: ...
+    def max_blocks(self) -> int:
+        """
+        Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig) evicts blocks down to the new cap at once: the least recently updated first, among equally recent ones the farthest from the last sensor origin.
+        """
     @max_blocks.setter
     def max_blocks(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
-    def max_depth_m(self) -> float: ...
+    def max_depth_m(self) -> float:
+        """
+        farther depths are invalid (at most 1000 m)
+        """
     @max_depth_m.setter
     def max_depth_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def max_weight(self) -> float: ...
+    def max_weight(self) -> float:
+        """
+        Cap on the fused weight, so the map keeps following a changing scene (0 = no cap).
+        """
     @max_weight.setter
     def max_weight(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def min_depth_m(self) -> float: ...
+    def min_depth_m(self) -> float:
+        """
+        closer depths are invalid
+        """
     @min_depth_m.setter
     def min_depth_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def min_weight(self) -> float: ...
+    def min_weight(self) -> float:
+        """
+        Voxels whose weight is below this are "unobserved" for meshing and queries.
+        """
     @min_weight.setter
     def min_weight(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def no_return_carve_min_valid_fraction(self) -> float: ...
+    def no_return_carve_min_valid_fraction(self) -> float:
+        """
+        With carve_free_space, a +Inf pixel ("no return within range", REP 118) carves its ray up to max_depth_m only in a frame where at least this fraction of all pixels are valid depths: the returns are the evidence that the sensor works and the pose is right. In other frames its +Inf pixels are ignored like invalid ones (and counted): one frame without any return (a covered or failing sensor) would otherwise carve through every wall in view. 0 = +Inf always carves; 1 = only frames without any invalid or +Inf pixel (so +Inf never carves). Without carving, +Inf pixels only free voxels of blocks the frame's returns allocate.
+        """
     @no_return_carve_min_valid_fraction.setter
     def no_return_carve_min_valid_fraction(
         self, arg0: typing.SupportsFloat | typing.SupportsIndex
     ) -> None: ...
     @property
-    def truncation_voxels(self) -> float: ...
+    def truncation_voxels(self) -> float:
+        """
+        Truncation distance mu in voxels (mu = truncation_voxels * voxel_size_m); 3-5 is usual.
+        """
     @truncation_voxels.setter
     def truncation_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def voxel_size_m(self) -> float: ...
+    def voxel_size_m(self) -> float:
+        """
+        voxel edge, m; fixed for the map's life
+        """
     @voxel_size_m.setter
     def voxel_size_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def weighting(self) -> TsdfWeighting:
+        """
+        weight of one observation
+        """
+    @weighting.setter
+    def weighting(self, arg0: TsdfWeighting) -> None: ...
 
 class TsdfIntegrationStats:
     """
     What one TSDF integration did: pixels by kind, blocks touched, allocated, refused, evicted, voxels updated.
     """
     @property
-    def blocks_allocated(self) -> int: ...
+    def blocks_allocated(self) -> int:
+        """
+        of them new this frame
+        """
     @property
-    def blocks_evicted(self) -> int: ...
+    def blocks_evicted(self) -> int:
+        """
+        farther than max_block_distance_m
+        """
     @property
-    def blocks_refused(self) -> int: ...
+    def blocks_refused(self) -> int:
+        """
+        not allocated: max_blocks reached (>= 1 if so)
+        """
     @property
-    def blocks_touched(self) -> int: ...
+    def blocks_touched(self) -> int:
+        """
+        blocks the frame's truncation band (or rays) reached
+        """
     @property
-    def pixels_invalid(self) -> int: ...
+    def pixels_invalid(self) -> int:
+        """
+        NaN, 0, negative or outside [min_depth_m, max_depth_m]
+        """
     @property
-    def pixels_no_return(self) -> int: ...
+    def pixels_no_return(self) -> int:
+        """
+        +Inf (REP-118: nothing within range)
+        """
     @property
-    def pixels_no_return_ignored(self) -> int: ...
+    def pixels_no_return_ignored(self) -> int:
+        """
+        +Inf pixels ignored: carving, in a frame with too few valid depths (no_return_carve_min_valid_fraction); also counted in pixels_no_return.
+        """
     @property
-    def pixels_valid(self) -> int: ...
+    def pixels_valid(self) -> int:
+        """
+        depths (or points) used
+        """
     @property
     def refused(self) -> typing.Any:
         """
         Why the whole frame was refused (its pixels counted invalid), or None.
         """
     @property
-    def voxels_updated(self) -> int: ...
+    def voxels_updated(self) -> int:
+        """
+        voxels fused this frame
+        """
 
 class Tsdf:
     """
@@ -483,16 +635,25 @@ class Tsdf:
         Writes the welded mesh as a PLY file.
         """
     @property
-    def block_count(self) -> int: ...
+    def block_count(self) -> int:
+        """
+        allocated 8^3-voxel blocks
+        """
     @property
     def blocks_evicted_to_cap(self) -> int:
         """
         Blocks evicted because set_config lowered max_blocks below the block count (total).
         """
     @property
-    def config(self) -> TsdfConfig: ...
+    def config(self) -> TsdfConfig:
+        """
+        the configuration in use
+        """
     @property
-    def esdf_block_count(self) -> int: ...
+    def esdf_block_count(self) -> int:
+        """
+        ESDF blocks (at most one per TSDF block)
+        """
     @property
     def esdf_config(self) -> EsdfConfig:
         """
@@ -504,7 +665,10 @@ class Tsdf:
         Bytes held by the ESDF's blocks, hash table and scratch.
         """
     @property
-    def memory_bytes(self) -> int: ...
+    def memory_bytes(self) -> int:
+        """
+        bytes (octomap's count for the OctoMap; the blocks' chunks for the TSDF)
+        """
 
 class EsdfConfig:
     """
@@ -518,7 +682,7 @@ class EsdfConfig:
     @property
     def max_distance_m(self) -> float:
         """
-        distances are clamped at this (m); also a change's reach
+        Distances are clamped at this (m). Also the reach of a change: a voxel that changes state alters distances within this radius only. (Distances are clamped at this (m). Also the reach of a change: a voxel that changes state alters distances within this radius only. (distances are clamped at this (m); also a change's reach))
         """
     @max_distance_m.setter
     def max_distance_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
@@ -528,19 +692,40 @@ class EsdfUpdateStats:
     What one ESDF update did: full or incremental, regions, voxels changed.
     """
     @property
-    def blocks_read(self) -> int: ...
+    def blocks_read(self) -> int:
+        """
+        TSDF blocks re-read (integrated since the last update)
+        """
     @property
-    def blocks_removed(self) -> int: ...
+    def blocks_removed(self) -> int:
+        """
+        blocks the TSDF no longer has
+        """
     @property
-    def blocks_written(self) -> int: ...
+    def blocks_written(self) -> int:
+        """
+        blocks whose distances were recomputed
+        """
     @property
-    def full(self) -> bool: ...
+    def full(self) -> bool:
+        """
+        every block recomputed
+        """
     @property
-    def region_voxels(self) -> int: ...
+    def region_voxels(self) -> int:
+        """
+        voxels in those regions (seed margins included)
+        """
     @property
-    def regions(self) -> int: ...
+    def regions(self) -> int:
+        """
+        distance-transform regions
+        """
     @property
-    def voxels_changed(self) -> int: ...
+    def voxels_changed(self) -> int:
+        """
+        voxels whose state changed
+        """
 
 class LogOddsConfig:
     """
@@ -552,27 +737,45 @@ class LogOddsConfig:
         Empty string if valid, else the reason.
         """
     @property
-    def clamp_max(self) -> float: ...
+    def clamp_max(self) -> float:
+        """
+        upper log-odds clamp (keeps walls un-learnable in bounded time)
+        """
     @clamp_max.setter
     def clamp_max(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def clamp_min(self) -> float: ...
+    def clamp_min(self) -> float:
+        """
+        lower log-odds clamp (keeps free cells re-learnable)
+        """
     @clamp_min.setter
     def clamp_min(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def free_threshold(self) -> float: ...
+    def free_threshold(self) -> float:
+        """
+        log-odds below this -> free (p < 0.119)
+        """
     @free_threshold.setter
     def free_threshold(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def occupied_threshold(self) -> float: ...
+    def occupied_threshold(self) -> float:
+        """
+        log-odds above this -> occupied (p > 0.881)
+        """
     @occupied_threshold.setter
     def occupied_threshold(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def p_hit(self) -> float: ...
+    def p_hit(self) -> float:
+        """
+        inverse sensor model: P(occupied) given a return in the cell
+        """
     @p_hit.setter
     def p_hit(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def p_miss(self) -> float: ...
+    def p_miss(self) -> float:
+        """
+        P(occupied) given a beam passing through the cell
+        """
     @p_miss.setter
     def p_miss(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
@@ -652,44 +855,94 @@ class LogOddsGrid:
         (size_y, size_x) int8: -1 unknown, 0 free, 1 occupied (by the thresholds).
         """
     @property
-    def config(self) -> LogOddsConfig: ...
+    def config(self) -> LogOddsConfig:
+        """
+        the configuration in use
+        """
     @property
-    def geometry(self) -> GridGeometry: ...
+    def geometry(self) -> GridGeometry:
+        """
+        the grid's geometry
+        """
     @property
-    def hit_increment(self) -> float: ...
+    def hit_increment(self) -> float:
+        """
+        log-odds added by a return, after rounding to the quantum
+        """
     @property
-    def memory_bytes(self) -> int: ...
+    def memory_bytes(self) -> int:
+        """
+        bytes held by the cells
+        """
     @property
-    def miss_increment(self) -> float: ...
+    def miss_increment(self) -> float:
+        """
+        log-odds added by a pass, after rounding to the quantum
+        """
 
 class ScanIntegratorConfig:
     """
     Ranges (m) and REP-117 options of the scan integrator (costmap_2d's obstacle-source keys).
     """
-
-    clearing: bool
-    inf_is_valid: bool
-    marking: bool
-    range_max_is_no_return: bool
     def __init__(self) -> None: ...
     def validate(self) -> str:
         """
         Empty string if the configuration is valid, else the reason (what the constructors raise).
         """
     @property
-    def obstacle_max_range(self) -> float: ...
+    def clearing(self) -> bool:
+        """
+        beams clear the cells they cross
+        """
+    @clearing.setter
+    def clearing(self, arg0: bool) -> None: ...
+    @property
+    def inf_is_valid(self) -> bool:
+        """
+        +Inf means "no return": clear, do not mark
+        """
+    @inf_is_valid.setter
+    def inf_is_valid(self, arg0: bool) -> None: ...
+    @property
+    def marking(self) -> bool:
+        """
+        returns mark their cell
+        """
+    @marking.setter
+    def marking(self, arg0: bool) -> None: ...
+    @property
+    def obstacle_max_range(self) -> float:
+        """
+        m: returns farther than this do not mark
+        """
     @obstacle_max_range.setter
     def obstacle_max_range(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def obstacle_min_range(self) -> float: ...
+    def obstacle_min_range(self) -> float:
+        """
+        m: returns nearer than this do not mark
+        """
     @obstacle_min_range.setter
     def obstacle_min_range(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def raytrace_max_range(self) -> float: ...
+    def range_max_is_no_return(self) -> bool:
+        """
+        treat r == range_max as +Inf
+        """
+    @range_max_is_no_return.setter
+    def range_max_is_no_return(self, arg0: bool) -> None: ...
+    @property
+    def raytrace_max_range(self) -> float:
+        """
+        m: clearing stops this far from the sensor
+        """
     @raytrace_max_range.setter
     def raytrace_max_range(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def raytrace_min_range(self) -> float: ...
+    def raytrace_min_range(self) -> float:
+        """
+        m: clearing starts this far from the sensor
+        """
     @raytrace_min_range.setter
     def raytrace_min_range(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
@@ -702,27 +955,60 @@ class IntegrationStats:
         Cells cleared per cell marked (the phantom-wall diagnostic; healthy >> 1).
         """
     @property
-    def beams(self) -> int: ...
+    def beams(self) -> int:
+        """
+        beams offered
+        """
     @property
-    def beams_beyond_obstacle_range(self) -> int: ...
+    def beams_beyond_obstacle_range(self) -> int:
+        """
+        returns too far (or near) to mark
+        """
     @property
-    def beams_invalid(self) -> int: ...
+    def beams_invalid(self) -> int:
+        """
+        NaN, -Inf, outside [range_min, range_max]
+        """
     @property
-    def beams_marked(self) -> int: ...
+    def beams_marked(self) -> int:
+        """
+        beams whose hit cell got (or shared) a hit update
+        """
     @property
-    def beams_no_return(self) -> int: ...
+    def beams_no_return(self) -> int:
+        """
+        +Inf (or range_max when treated so) beams that cleared
+        """
     @property
-    def cells_changed(self) -> int: ...
+    def cells_changed(self) -> int:
+        """
+        cells whose state (free/occupied/unknown) changed
+        """
     @property
-    def cells_cleared(self) -> int: ...
+    def cells_cleared(self) -> int:
+        """
+        Cells walked by clearing rays, per beam (a cell two beams cross counts twice, as in the lesson's "a 10 m beam clears ~200 cells"). Each cell still receives at most one miss update per scan, and none if it was hit in the same scan.
+        """
     @property
-    def cells_marked(self) -> int: ...
+    def cells_marked(self) -> int:
+        """
+        cells that received a hit update
+        """
     @property
-    def changed(self) -> tuple: ...
+    def changed(self) -> tuple:
+        """
+        (x0, y0, x1, y1) cells whose state changed, or None
+        """
     @property
-    def points_merged(self) -> int: ...
+    def points_merged(self) -> int:
+        """
+        cloud points sharing a merge cell with an earlier one
+        """
     @property
-    def points_outside_height(self) -> int: ...
+    def points_outside_height(self) -> int:
+        """
+        cloud points outside [min, max]_obstacle_height
+        """
     @property
     def touched(self) -> tuple:
         """
@@ -786,38 +1072,58 @@ class ScanIntegrator:
         Like integrate(), for a scan swept while the sensor moved: each beam is cast from the pose interpolated between the first and the last beam's pose (per-beam correction).
         """
     @property
-    def config(self) -> ScanIntegratorConfig: ...
+    def config(self) -> ScanIntegratorConfig:
+        """
+        the configuration in use
+        """
 
 class StaticMapConfig:
     """
     How an OccupancyGrid becomes costs (map_server's thresholds, track_unknown_space, trinary_costmap).
     """
-
-    track_unknown_space: bool
-    trinary_costmap: bool
-    use_maximum: bool
     def __init__(self) -> None: ...
     @property
     def lethal_cost_threshold(self) -> int:
         """
-        occupancy value 0..100 (clamped) from which a cell is lethal
+        occupancy value (0..100) from which a cell is lethal (occupancy value (0..100) from which a cell is lethal (occupancy value 0..100 (clamped) from which a cell is lethal))
         """
     @lethal_cost_threshold.setter
     def lethal_cost_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
     def max_cells(self) -> int:
         """
-        largest map accepted, cells
+        Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell here, one in the master, one in each published grid). (Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell here, one in the master, one in each published grid). (largest map accepted, cells))
         """
     @max_cells.setter
     def max_cells(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
+    def track_unknown_space(self) -> bool:
+        """
+        costmap_2d's StaticLayer default (layer level)
+        """
+    @track_unknown_space.setter
+    def track_unknown_space(self, arg0: bool) -> None: ...
+    @property
+    def trinary_costmap(self) -> bool:
+        """
+        false: below-lethal values scale to 0..253
+        """
+    @trinary_costmap.setter
+    def trinary_costmap(self, arg0: bool) -> None: ...
+    @property
     def unknown_cost_value(self) -> int:
         """
-        occupancy value meaning unknown, compared as a byte (-1 = 255)
+        occupancy value meaning unknown (compared as a byte) (occupancy value meaning unknown (compared as a byte) (occupancy value meaning unknown, compared as a byte (-1 = 255)))
         """
     @unknown_cost_value.setter
     def unknown_cost_value(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    @property
+    def use_maximum(self) -> bool:
+        """
+        combine with the master by max instead of overwriting
+        """
+    @use_maximum.setter
+    def use_maximum(self, arg0: bool) -> None: ...
 
 class StaticMap:
     """
@@ -848,9 +1154,15 @@ class StaticMap:
         Replaces the map ([y, x] int8 occupancy); ValueError (map kept) if it is refused.
         """
     @property
-    def geometry(self) -> GridGeometry: ...
+    def geometry(self) -> GridGeometry:
+        """
+        the grid's geometry
+        """
     @property
-    def has_map(self) -> bool: ...
+    def has_map(self) -> bool:
+        """
+        whether a map was accepted
+        """
     @property
     def last_change(self) -> tuple[int, int, int, int]:
         """
@@ -863,7 +1175,6 @@ class InflationConfig:
     """
 
     MAX_RADIUS_CELLS: typing.ClassVar[int] = 2000
-    inflate_unknown: bool
     def __init__(self) -> None: ...
     @typing.overload
     def validate(self) -> str:
@@ -878,21 +1189,28 @@ class InflationConfig:
     @property
     def cost_scaling_factor(self) -> float:
         """
-        1/m
+        1/m: exponential decay rate beyond the inscribed radius
         """
     @cost_scaling_factor.setter
     def cost_scaling_factor(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
+    def inflate_unknown(self) -> bool:
+        """
+        write inflated costs over NO_INFORMATION cells (costmap_2d)
+        """
+    @inflate_unknown.setter
+    def inflate_unknown(self, arg0: bool) -> None: ...
+    @property
     def inflation_radius(self) -> float:
         """
-        m
+        m: cells farther than this from any lethal cell get 0
         """
     @inflation_radius.setter
     def inflation_radius(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def inscribed_radius(self) -> float:
         """
-        m
+        m: from the footprint; cells this close get 253
         """
     @inscribed_radius.setter
     def inscribed_radius(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
@@ -909,40 +1227,43 @@ class PredictionConfig:
     @property
     def max_object_size_m(self) -> float:
         """
-        m
+        m: larger box sides are clamped to this (bad sizes)
         """
     @max_object_size_m.setter
     def max_object_size_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def max_speed_mps(self) -> float:
         """
-        m/s
+        m/s: faster tracks are not swept (bad velocities)
         """
     @max_speed_mps.setter
     def max_speed_mps(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def max_uncertainty_m(self) -> float:
         """
-        m
+        m: cap on that growth, so a track with an absurd covariance cannot blank the map.
         """
     @max_uncertainty_m.setter
     def max_uncertainty_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def min_object_size_m(self) -> float:
         """
-        m
+        m: smaller box sides are raised to this
         """
     @min_object_size_m.setter
     def min_object_size_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def prediction_horizon_s(self) -> float:
         """
-        s
+        s: how far ahead of now the object is swept
         """
     @prediction_horizon_s.setter
     def prediction_horizon_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def uncertainty_sigmas(self) -> float: ...
+    def uncertainty_sigmas(self) -> float:
+        """
+        k: the shape grows by k standard deviations of the predicted position (0 = box only).
+        """
     @uncertainty_sigmas.setter
     def uncertainty_sigmas(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
@@ -971,14 +1292,14 @@ class PlanarTrack:
     @property
     def box_yaw(self) -> float:
         """
-        rad
+        rad: the box's x axis in the costmap frame
         """
     @box_yaw.setter
     def box_yaw(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def position(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
         """
-        m
+        m, at the measurement stamp
         """
     @position.setter
     def position(
@@ -989,7 +1310,7 @@ class PlanarTrack:
         self,
     ) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
         """
-        m^2
+        m² (m² (m^2))
         """
     @position_covariance.setter
     def position_covariance(
@@ -998,7 +1319,7 @@ class PlanarTrack:
     @property
     def size_x(self) -> float:
         """
-        m
+        m, box side along the box's x axis
         """
     @size_x.setter
     def size_x(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
@@ -1023,7 +1344,7 @@ class PlanarTrack:
         self,
     ) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
         """
-        m^2/s^2
+        m²/s² (m²/s² (m^2/s^2))
         """
     @velocity_covariance.setter
     def velocity_covariance(
@@ -1105,9 +1426,6 @@ class TrackerConfig:
 
     MAX_BOX_COORDINATE_PX: typing.ClassVar[float] = 1000000.0
     MAX_POSITION_M: typing.ClassVar[float] = 100000000.0
-    class_aware: bool
-    mode: TrackerConfig.Mode
-    second_pass: bool
     @staticmethod
     def defaults_for(mode: TrackerConfig.Mode) -> TrackerConfig:
         """
@@ -1124,82 +1442,178 @@ class TrackerConfig:
         Empty string if the configuration is valid, else the reason (what the constructors raise).
         """
     @property
-    def accel_psd(self) -> float: ...
+    def accel_psd(self) -> float:
+        """
+        Spectral density of the white acceleration noise. Metric: m^2/s^3 per axis. Image: box heights^2/s^3 (px^2/s^3 per px^2 of box height), so it scales with the apparent size.
+        """
     @accel_psd.setter
     def accel_psd(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def duplicate_confidence(self) -> float: ...
+    def class_aware(self) -> bool:
+        """
+        tracks only take detections of their class
+        """
+    @class_aware.setter
+    def class_aware(self, arg0: bool) -> None: ...
+    @property
+    def duplicate_confidence(self) -> float:
+        """
+        Metric mode: a coasting track this close (chi-square gate, 2 dof, sum of both position covariances) to a track born while it coasted and updated this frame is its duplicate and is removed. 0.9 -> 4.61, about 0.3 m at 0.1 m uncertainty.
+        """
     @duplicate_confidence.setter
     def duplicate_confidence(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def gate_confidence(self) -> float: ...
+    def gate_confidence(self) -> float:
+        """
+        chi-square gate (metric): 2 dof, 0.99 -> 9.21, 0.999 -> 13.8
+        """
     @gate_confidence.setter
     def gate_confidence(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def high_score(self) -> float: ...
+    def high_score(self) -> float:
+        """
+        detections at or above: first pass, may start tracks
+        """
     @high_score.setter
     def high_score(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def initial_velocity_std(self) -> float: ...
+    def initial_velocity_std(self) -> float:
+        """
+        m/s (metric) or box heights/s (image)
+        """
     @initial_velocity_std.setter
     def initial_velocity_std(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def low_score(self) -> float: ...
+    def low_score(self) -> float:
+        """
+        below: ignored; in between: second pass only
+        """
     @low_score.setter
     def low_score(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def max_age_s(self) -> float: ...
+    def max_age_s(self) -> float:
+        """
+        s a confirmed track coasts without detections (both modes)
+        """
     @max_age_s.setter
     def max_age_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def measurement_std(self) -> float: ...
+    def measurement_std(self) -> float:
+        """
+        Metric: m, position noise of detections without a covariance. Image: box heights (std of each of centre x, centre y, width and height in px per px of box height).
+        """
     @measurement_std.setter
     def measurement_std(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def min_hits(self) -> int: ...
+    def min_hits(self) -> int:
+        """
+        Updates before a track is confirmed; a tentative track that misses one is dropped. Image default 2 (see defaultsFor).
+        """
     @min_hits.setter
     def min_hits(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
-    def min_iou(self) -> float: ...
+    def min_iou(self) -> float:
+        """
+        image mode: minimum IoU to associate
+        """
     @min_iou.setter
     def min_iou(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def reid_confidence(self) -> float: ...
+    def mode(self) -> TrackerConfig.Mode:
+        """
+        The member initialisers below are the metric defaults (a default-constructed config is metric, as it always was). Image mode has its own defaults: start from defaultsFor(kImage).
+        """
+    @mode.setter
+    def mode(self, arg0: TrackerConfig.Mode) -> None: ...
+    @property
+    def reid_confidence(self) -> float:
+        """
+        Metric mode: a track confirmed this frame takes the id of a track that was already coasting at its birth when their positions agree within this chi-square gate (2 dof, sum of covariances): re-identification after an occlusion the gate could not bridge. 0.99999 -> 23.0.
+        """
     @reid_confidence.setter
     def reid_confidence(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def second_pass(self) -> bool:
+        """
+        ByteTrack's low-score association
+        """
+    @second_pass.setter
+    def second_pass(self, arg0: bool) -> None: ...
 
 class TrackerStats:
     """
     What one tracker step did: detections by kind, matches per pass, births, deaths, duplicates, re-identifications.
     """
     @property
-    def births(self) -> int: ...
+    def births(self) -> int:
+        """
+        new tentative tracks
+        """
     @property
-    def confirmed(self) -> int: ...
+    def confirmed(self) -> int:
+        """
+        of them confirmed or coasting
+        """
     @property
-    def deaths(self) -> int: ...
+    def deaths(self) -> int:
+        """
+        includes duplicates removed
+        """
     @property
-    def detections(self) -> int: ...
+    def detections(self) -> int:
+        """
+        detections given to step()
+        """
     @property
-    def detections_ignored_low_score(self) -> int: ...
+    def detections_ignored_low_score(self) -> int:
+        """
+        scores below low_score
+        """
     @property
-    def detections_rejected_invalid(self) -> int: ...
+    def detections_rejected_invalid(self) -> int:
+        """
+        NaN/Inf, boxes with min > max or no area, negative sizes, covariances that are not positive semi-definite
+        """
     @property
-    def detections_rejected_out_of_range(self) -> int: ...
+    def detections_rejected_out_of_range(self) -> int:
+        """
+        Finite but beyond TrackerConfig::kMaxBoxCoordinatePx (image) or kMaxPositionM (metric)
+        """
     @property
-    def duplicates_removed(self) -> int: ...
+    def duplicates_removed(self) -> int:
+        """
+        coasting tracks removed as duplicates of new ones
+        """
     @property
-    def id_switches(self) -> int: ...
+    def id_switches(self) -> int:
+        """
+        truth objects whose track id changed (needs truth ids)
+        """
     @property
-    def matched_first_pass(self) -> int: ...
+    def matched_first_pass(self) -> int:
+        """
+        high-score detections assigned to a track
+        """
     @property
-    def matched_second_pass(self) -> int: ...
+    def matched_second_pass(self) -> int:
+        """
+        low-score detections assigned (ByteTrack's pass)
+        """
     @property
-    def reidentified(self) -> int: ...
+    def reidentified(self) -> int:
+        """
+        new tracks that took a coasting track's id
+        """
     @property
-    def tracks(self) -> int: ...
+    def tracks(self) -> int:
+        """
+        live tracks after the step (every state)
+        """
     @property
-    def unmatched_outside_gate(self) -> int: ...
+    def unmatched_outside_gate(self) -> int:
+        """
+        high-score detections no track could take
+        """
 
 class Tracker:
     """
@@ -1240,28 +1654,28 @@ class SeamLimits:
     @property
     def max_map_odom_age_s(self) -> float:
         """
-        s
+        s: warn when map <- odom is older
         """
     @max_map_odom_age_s.setter
     def max_map_odom_age_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def max_smear_m(self) -> float:
         """
-        m
+        m: warn when the expected smear exceeds it
         """
     @max_smear_m.setter
     def max_smear_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def max_transform_age_s(self) -> float:
         """
-        s
+        s: warn when an input's p95 transform age exceeds it
         """
     @max_transform_age_s.setter
     def max_transform_age_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def reference_range_m(self) -> float:
         """
-        m
+        m: the range at which the smear is judged
         """
     @reference_range_m.setter
     def reference_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
@@ -1278,42 +1692,42 @@ class CorrectionMonitorConfig:
     @property
     def max_correction_m(self) -> float:
         """
-        m
+        m: warn above (the lesson: 2 m ~ 100 m of 2 % drift)
         """
     @max_correction_m.setter
     def max_correction_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def min_travel_m(self) -> float:
         """
-        m
+        m of robot travel within the window after which a correction stuck at zero is suspicious (the localiser may be silently rejecting fixes).
         """
     @min_travel_m.setter
     def min_travel_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def ramp_m(self) -> float:
         """
-        m
+        m the correction must grow within the window without a single reset before it counts as "never resets" (loop closures not firing).
         """
     @ramp_m.setter
     def ramp_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def reset_drop_m(self) -> float:
         """
-        m
+        m: a fall of the correction this large is a correction event
         """
     @reset_drop_m.setter
     def reset_drop_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def window_s(self) -> float:
         """
-        s
+        s of history judged
         """
     @window_s.setter
     def window_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def zero_epsilon_m(self) -> float:
         """
-        m
+        m: a correction this small counts as zero
         """
     @zero_epsilon_m.setter
     def zero_epsilon_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
@@ -1358,14 +1772,15 @@ class CorrectionMonitor:
         Whether the latest correction exceeds max_correction_m.
         """
     @property
-    def resets(self) -> int: ...
+    def resets(self) -> int:
+        """
+        corrections seen to reset (drops larger than reset_drop_m) in the window
+        """
 
 class VoxelMapConfig:
     """
     3-D voxel obstacle map settings (costmap_2d VoxelLayer's meaning).
     """
-
-    log_odds: LogOddsConfig
     def __init__(self) -> None: ...
     def validate(self) -> str:
         """
@@ -1374,61 +1789,77 @@ class VoxelMapConfig:
     @property
     def decay_time_s(self) -> float:
         """
-        0 = no decay
+        Time constant of the decay toward unknown, s: evidence is multiplied by exp(-dt / tau) for the time dt since the voxel's last update. 0 = no decay (costmap_2d has none). Default 0.
         """
     @decay_time_s.setter
     def decay_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
+    def log_odds(self) -> LogOddsConfig:
+        """
+        Inverse sensor model per voxel. Defaults: p_hit 0.7 (+0.847), p_miss 0.4 (-0.405), clamp [-2, 3.5] (octomap's 0.12 / 0.97), occupied above 0.5 (one hit marks, as in costmap_2d), free below -0.3 (one miss frees).
+        """
+    @log_odds.setter
+    def log_odds(self, arg0: LogOddsConfig) -> None: ...
+    @property
     def mark_threshold(self) -> int:
         """
-        a column with more occupied band voxels than this is lethal
+        A column with MORE than this many occupied voxels in the height band is lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. (A column with MORE than this many occupied voxels in the height band is lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. (a column with more occupied band voxels than this is lethal))
         """
     @mark_threshold.setter
     def mark_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
-    def max_memory_mib(self) -> float: ...
+    def max_memory_mib(self) -> float:
+        """
+        Memory bound for the voxel blocks, MiB. Updates that would need a block beyond it are dropped and counted. Default 64.
+        """
     @max_memory_mib.setter
     def max_memory_mib(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def max_obstacle_height_m(self) -> float: ...
+    def max_obstacle_height_m(self) -> float:
+        """
+        top of the band projected into the costmap, m
+        """
     @max_obstacle_height_m.setter
     def max_obstacle_height_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def min_obstacle_height_m(self) -> float: ...
+    def min_obstacle_height_m(self) -> float:
+        """
+        The robot's height band, m: only voxels whose centre lies in [min, max] are projected into the 2-D costmap (an overhang above the robot is kept in 3-D but ignored). Defaults 0 and 2.
+        """
     @min_obstacle_height_m.setter
     def min_obstacle_height_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def origin_z_m(self) -> float:
         """
-        bottom of voxel layer 0 (m)
+        Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0. (Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0. (bottom of voxel layer 0 (m)))
         """
     @origin_z_m.setter
     def origin_z_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def resolution_m(self) -> float:
         """
-        voxel edge in x, y (m)
+        Edge of a voxel in x and y, m (the layer uses the costmap's resolution). Default 0.05. (Edge of a voxel in x and y, m (the layer uses the costmap's resolution). Default 0.05. (voxel edge in x, y (m)))
         """
     @resolution_m.setter
     def resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def unknown_threshold(self) -> int:
         """
-        a column with at most this many unknown band voxels is known
+        A column with AT MOST this many unknown voxels in the band is known; a known column that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with 10 voxels: every column counts as known, as in costmap_2d). (A column with AT MOST this many unknown voxels in the band is known; a known column that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with 10 voxels: every column counts as known, as in costmap_2d). (a column with at most this many unknown band voxels is known))
         """
     @unknown_threshold.setter
     def unknown_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
     def z_resolution_m(self) -> float:
         """
-        voxel height (m)
+        Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (voxel height (m)))
         """
     @z_resolution_m.setter
     def z_resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def z_voxels(self) -> int:
         """
-        voxels per column
+        Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most kMaxZVoxels). Default 10. (Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most kMaxZVoxels). Default 10. (voxels per column))
         """
     @z_voxels.setter
     def z_voxels(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
@@ -1437,31 +1868,51 @@ class VoxelRayConfig:
     """
     How far a source's rays mark and clear.
     """
-
-    clearing: bool
-    marking: bool
     def __init__(self) -> None: ...
     def validate(self) -> str:
         """
         Empty string if valid, else the reason.
         """
     @property
-    def no_return_range_m(self) -> float: ...
+    def clearing(self) -> bool:
+        """
+        rays clear the voxels they cross
+        """
+    @clearing.setter
+    def clearing(self, arg0: bool) -> None: ...
+    @property
+    def marking(self) -> bool:
+        """
+        returns mark their voxel
+        """
+    @marking.setter
+    def marking(self, arg0: bool) -> None: ...
+    @property
+    def no_return_range_m(self) -> float:
+        """
+        a no-return ray clears this far, m
+        """
     @no_return_range_m.setter
     def no_return_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
-    def obstacle_max_range_m(self) -> float: ...
+    def obstacle_max_range_m(self) -> float:
+        """
+        returns farther than this do not mark (3-D distance)
+        """
     @obstacle_max_range_m.setter
     def obstacle_max_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def one_ray_per_end_voxel(self) -> bool:
         """
-        cast only the first ray of a frame ending in each voxel
+        Of the rays of a frame that end in the same voxel, cast only the first (every return still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour). (Of the rays of a frame that end in the same voxel, cast only the first (every return still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour). (cast only the first ray of a frame ending in each voxel))
         """
     @one_ray_per_end_voxel.setter
     def one_ray_per_end_voxel(self, arg0: bool) -> None: ...
     @property
-    def raytrace_max_range_m(self) -> float: ...
+    def raytrace_max_range_m(self) -> float:
+        """
+        rays clear at most this far, m
+        """
     @raytrace_max_range_m.setter
     def raytrace_max_range_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
@@ -1564,21 +2015,45 @@ class VoxelMap:
         -1 unknown, 0 free, 1 occupied.
         """
     @property
-    def band(self) -> tuple[int, int]: ...
+    def band(self) -> tuple[int, int]:
+        """
+        (first, last) voxel layers inside the height band
+        """
     @property
-    def blocks(self) -> int: ...
+    def blocks(self) -> int:
+        """
+        allocated 8^3-voxel blocks
+        """
     @property
-    def config(self) -> VoxelMapConfig: ...
+    def config(self) -> VoxelMapConfig:
+        """
+        the configuration in use
+        """
     @property
-    def max_blocks(self) -> int: ...
+    def max_blocks(self) -> int:
+        """
+        blocks allowed by max_memory_mib
+        """
     @property
-    def memory_bytes(self) -> int: ...
+    def memory_bytes(self) -> int:
+        """
+        bytes held by blocks and the block table
+        """
     @property
-    def shape(self) -> tuple[int, int, int]: ...
+    def shape(self) -> tuple[int, int, int]:
+        """
+        (nx, ny, nz) voxels of the window
+        """
     @property
-    def window_offset(self) -> tuple[int, int]: ...
+    def window_offset(self) -> tuple[int, int]:
+        """
+        (x, y) index of the window's first column on the map's lattice
+        """
     @property
-    def window_origin(self) -> tuple[float, float]: ...
+    def window_origin(self) -> tuple[float, float]:
+        """
+        (x, y) of the window's lower-left corner, m
+        """
 
 def apply(
     arg0: Pose2D, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]
