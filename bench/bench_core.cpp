@@ -562,7 +562,8 @@ void runStaticMap(int iters) {
 // a 0.5 m box 2 m ahead, a table top (0.75 m) 1.5 m ahead on the left; depths beyond 4.5 m are
 // no-returns. A freshly noised frame (1 cm) every iteration. Timed: rays (back-projection) and
 // integration separately, and the column projection of the whole window.
-void runVoxel(int iters, int stride, bool clearing, bool one_ray_per_end_voxel = false) {
+void runVoxel(int iters, int stride, bool clearing, bool one_ray_per_end_voxel = false,
+              bool frustum = false) {
   PinholeCamera cam;
   cam.width = 640;
   cam.height = 480;
@@ -630,11 +631,16 @@ void runVoxel(int iters, int stride, bool clearing, bool one_ray_per_end_voxel =
   for (int k = 0; k < iters; ++k) {
     render();
     auto t0 = std::chrono::steady_clock::now();
-    depthToRays(depth.data(), cam, pose, false, stride, &out);
-    ray_ms.push_back(msSince(t0));
-    t0 = std::chrono::steady_clock::now();
-    last = map.integrate(pose.translation(), out.hits.data(), out.hits.size() / 3,
-                         out.no_returns.data(), out.no_returns.size() / 3, 0.1 * k, rays);
+    if (frustum) {  // back-projection, marking and frustum clearing in one call
+      ray_ms.push_back(0.0);
+      last = map.integrateDepthFrustum(depth.data(), cam, pose, false, stride, 0.1 * k, rays);
+    } else {
+      depthToRays(depth.data(), cam, pose, false, stride, &out);
+      ray_ms.push_back(msSince(t0));
+      t0 = std::chrono::steady_clock::now();
+      last = map.integrate(pose.translation(), out.hits.data(), out.hits.size() / 3,
+                           out.no_returns.data(), out.no_returns.size() / 3, 0.1 * k, rays);
+    }
     integrate_ms.push_back(msSince(t0));
     t0 = std::chrono::steady_clock::now();
     map.project(0.1 * k, &costs);
@@ -646,16 +652,17 @@ void runVoxel(int iters, int stride, bool clearing, bool one_ray_per_end_voxel =
       std::count(costs.begin(), costs.end(), static_cast<std::uint8_t>(254)));
   std::printf(
       "{\"bench\": \"voxel_depth\", \"width\": 640, \"height\": 480, \"stride\": %d, "
-      "\"clearing\": %s, \"one_ray_per_end_voxel\": %s, \"voxel_m\": 0.05, \"range_m\": 4.0, "
+      "\"clearing\": %s, \"clearing_mode\": \"%s\", \"one_ray_per_end_voxel\": %s, "
+      "\"voxel_m\": 0.05, \"range_m\": 4.0, "
       "\"iters\": %d, \"rays\": %zu, "
       "\"voxels_walked\": %zu, \"marked\": %zu, \"cleared\": %zu, \"frame_median_ms\": %.3f, "
       "\"frame_p90_ms\": %.3f, \"rays_median_ms\": %.3f, \"integrate_median_ms\": %.3f, "
       "\"project_median_ms\": %.3f, \"blocks\": %zu, \"memory_bytes\": %zu, \"lethal_columns\": "
       "%zu}\n",
-      stride, clearing ? "true" : "false", one_ray_per_end_voxel ? "true" : "false", iters,
-      last.rays, last.voxels_walked, last.marked, last.cleared, medianOf(total), p90Of(total),
-      medianOf(ray_ms), medianOf(integrate_ms), medianOf(project_ms), map.blocks(),
-      map.memoryBytes(), lethal);
+      stride, clearing ? "true" : "false", frustum ? "frustum" : "ray",
+      one_ray_per_end_voxel ? "true" : "false", iters, last.rays, last.voxels_walked, last.marked,
+      last.cleared, medianOf(total), p90Of(total), medianOf(ray_ms), medianOf(integrate_ms),
+      medianOf(project_ms), map.blocks(), map.memoryBytes(), lethal);
 }
 
 void runVoxelRows(int iters) {
@@ -664,6 +671,8 @@ void runVoxelRows(int iters) {
   runVoxel(n, 1, false);       // marking only: what the clearing costs
   runVoxel(n, 2, true);        // every 2nd pixel in x and y
   runVoxel(n, 1, true, true);  // every pixel, one ray per end voxel
+  runVoxel(n, 1, true, false, true);  // frustum clearing, every pixel marks
+  runVoxel(n, 2, true, false, true);  // frustum clearing, every 2nd pixel marks (all clear)
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "downstream_perception/core/grid/cost_values.h"
@@ -119,6 +120,8 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   reader.get("camera_info_topic", &s->camera_info_topic);
   reader.get("zero_is_no_return", &s->zero_is_no_return);
   reader.get("one_ray_per_end_voxel", &s->rays.one_ray_per_end_voxel);
+  std::string clearing_mode = "ray";
+  reader.get("clearing_mode", &clearing_mode);
   reader.get("stride", &s->stride);
   reader.get("tf_queue_size", &s->tf_queue_size);
   reader.unsupported("min_obstacle_height",
@@ -133,6 +136,12 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   std::string why = s->rays.validate();
   if (data_type != "PointCloud2" && data_type != "DepthImage") {
     why = "data_type '" + data_type + "' is not supported (PointCloud2 or DepthImage)";
+  } else if (clearing_mode != "ray" && clearing_mode != "frustum") {
+    why = "clearing_mode '" + clearing_mode + "' is not supported (ray or frustum)";
+  } else if (clearing_mode == "frustum" && data_type != "DepthImage") {
+    why =
+        "clearing_mode 'frustum' needs a DepthImage source (a cloud has no image to project "
+        "into)";
   } else if (s->stride < 1 || s->stride > 64) {
     why = "stride must be in [1, 64] pixels, got " + std::to_string(s->stride);
   } else if (s->tf_queue_size < 1 || s->tf_queue_size > 10000) {
@@ -143,6 +152,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
     return;
   }
   s->depth = data_type == "DepthImage";
+  s->frustum = clearing_mode == "frustum";
   if (s->depth && s->camera_info_topic.empty()) {
     // image_transport's convention: the camera_info next to the image.
     const std::size_t slash = s->topic.rfind('/');
@@ -263,13 +273,17 @@ void VoxelObstacleLayer::onDepth(Source* s, const sensor_msgs::ImageConstPtr& ms
   }
   std::vector<float> metres;
   std::string why;
-  if (!depthImageToMetres(*msg, &metres, &why)) {
+  if (!depthImageToMetres(*msg, &metres, &why, s->zero_is_no_return)) {
     reject(s, why);
     return;
   }
   Eigen::Isometry3d pose;
   if (!lookup(s, s->sensor_frame.empty() ? msg->header.frame_id : s->sensor_frame,
               msg->header.stamp, &pose)) {
+    return;
+  }
+  if (s->frustum) {
+    integrateFrustum(s, metres, *cam, pose, msg->header.stamp);
     return;
   }
   DepthRays rays;
@@ -307,13 +321,29 @@ void VoxelObstacleLayer::onCloud(Source* s, const sensor_msgs::PointCloud2ConstP
 void VoxelObstacleLayer::integrate(Source* s, const Eigen::Vector3d& origin,
                                    const std::vector<float>& hits,
                                    const std::vector<float>& no_returns, const ros::Time& stamp) {
+  runIntegration(s, stamp, [&] {
+    return map_->integrate(origin, hits.data(), hits.size() / 3, no_returns.data(),
+                           no_returns.size() / 3, stamp.toSec(), s->rays);
+  });
+}
+
+void VoxelObstacleLayer::integrateFrustum(Source* s, const std::vector<float>& metres,
+                                          const PinholeCamera& camera,
+                                          const Eigen::Isometry3d& pose, const ros::Time& stamp) {
+  runIntegration(s, stamp, [&] {
+    return map_->integrateDepthFrustum(metres.data(), camera, pose, s->zero_is_no_return, s->stride,
+                                       stamp.toSec(), s->rays);
+  });
+}
+
+void VoxelObstacleLayer::runIntegration(Source* s, const ros::Time& stamp,
+                                        const std::function<VoxelIntegrationStats()>& work) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!map_) return;
   const auto t0 = std::chrono::steady_clock::now();
   VoxelIntegrationStats stats;
   try {
-    stats = map_->integrate(origin, hits.data(), hits.size() / 3, no_returns.data(),
-                            no_returns.size() / 3, stamp.toSec(), s->rays);
+    stats = work();
   } catch (const std::invalid_argument& e) {
     ++s->rejected;
     s->last_rejection = e.what();

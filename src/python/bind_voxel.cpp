@@ -205,9 +205,14 @@ void bindVoxel(py::module& m) {
           "integrate_depth",
           [](VoxelMap& self, py::array_t<float, py::array::c_style | py::array::forcecast> depth,
              const PinholeCamera& camera, const Eigen::Matrix4d& T_world_camera, double stamp_s,
-             const VoxelRayConfig& rays, bool zero_is_no_return, int stride) {
+             const VoxelRayConfig& rays, bool zero_is_no_return, int stride,
+             const std::string& clearing_mode) {
             const std::string why = camera.validate();
             if (!why.empty()) throw std::invalid_argument("camera: " + why);
+            if (clearing_mode != "ray" && clearing_mode != "frustum") {
+              throw std::invalid_argument("clearing_mode must be 'ray' or 'frustum', got '" +
+                                          clearing_mode + "'");
+            }
             if (depth.ndim() != 2 || depth.shape(0) != camera.height ||
                 depth.shape(1) != camera.width) {
               throw std::invalid_argument("depth must be (height, width)");
@@ -217,9 +222,14 @@ void bindVoxel(py::module& m) {
             DepthRays r;
             {
               py::gil_scoped_release release;
-              depthToRays(depth.data(), camera, pose, zero_is_no_return, stride, &r);
-              s = self.integrate(pose.translation(), r.hits.data(), r.hits.size() / 3,
-                                 r.no_returns.data(), r.no_returns.size() / 3, stamp_s, rays);
+              if (clearing_mode == "frustum") {
+                s = self.integrateDepthFrustum(depth.data(), camera, pose, zero_is_no_return,
+                                               stride, stamp_s, rays);
+              } else {
+                depthToRays(depth.data(), camera, pose, zero_is_no_return, stride, &r);
+                s = self.integrate(pose.translation(), r.hits.data(), r.hits.size() / 3,
+                                   r.no_returns.data(), r.no_returns.size() / 3, stamp_s, rays);
+              }
             }
             py::dict d = statsToDict(s);
             d["invalid_pixels"] = r.invalid;
@@ -227,7 +237,12 @@ void bindVoxel(py::module& m) {
           },
           py::arg("depth"), py::arg("camera"), py::arg("T_world_camera"), py::arg("stamp_s"),
           py::arg("rays"), py::arg("zero_is_no_return") = false, py::arg("stride") = 1,
-          "A depth image (metres, REP 118: +Inf = no return) as one frame.")
+          py::arg("clearing_mode") = "ray",
+          "A depth image (metres, REP 118: +Inf = no return) as one frame. clearing_mode 'ray': "
+          "every stride-th pixel's ray clears the voxels it crosses (exact 3-D traversal); "
+          "'frustum': every voxel in view nearer than the depth of the pixel it projects to (by "
+          "more than half its diagonal) gets a miss, the spatio-temporal voxel layer's way, and "
+          "every stride-th pixel marks. invalid_pixels is counted in 'ray' mode only.")
       .def(
           "log_odds",
           [](const VoxelMap& self, int x, int y, int z, double now_s) {

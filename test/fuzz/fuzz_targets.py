@@ -1871,6 +1871,7 @@ def gen_voxel_map(rng: np.random.Generator) -> dict[str, Any]:
             ops.append(
                 (op, depth_args(g, cam["shape"]), cam, pose_matrix(g), g.f(0, 10, 0.1))
                 + (voxel_ray_config_args(g), g.b(), g.i(1, 3, 0.1, INT32_NASTY))
+                + (g.pick(("ray", "frustum", "frustum", "")),)
             )
         elif op == "window":
             ops.append(
@@ -1913,7 +1914,11 @@ def call_voxel_map(a: dict[str, Any]) -> Any:
                     problems.append(f"more updates than visits: {s}")
             elif op[0] == "depth":
                 rays = configure(c.VoxelRayConfig(), op[5])
-                vmap.integrate_depth(op[1], make_camera(op[2]), op[3], op[4], rays, op[6], op[7])
+                s = vmap.integrate_depth(
+                    op[1], make_camera(op[2]), op[3], op[4], rays, op[6], op[7], op[8]
+                )
+                if s["marked"] + s["cleared"] > s["voxels_walked"] + s["rays"]:
+                    problems.append(f"more updates than visits: {s}")
             elif op[0] == "window":
                 vmap.set_window(*op[1:])
                 moved = True

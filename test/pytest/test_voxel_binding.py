@@ -103,3 +103,46 @@ def test_invalid_input_is_refused() -> None:
     assert vmap.log_odds(6, 4, 4, 0.0) == pytest.approx(math.log(7 / 3), abs=1e-6)
     with pytest.raises(IndexError):
         vmap.log_odds(10, 0, 0, 0.0)
+
+
+@pytest.mark.parametrize("clearing_mode", ["ray", "frustum"])
+def test_frustum_and_ray_clearing_agree_on_the_table(clearing_mode: str) -> None:
+    # The same table top and camera path through both clearing modes: the top stays lethal, the
+    # space under it (seen by the low camera) is free, and a box that was there and is gone is
+    # cleared in both.
+    table = Box((0.8, 0.0, 0.75), (0.4, 0.4, 0.025))
+    # x 1.5 .. 1.7, y 0.5 .. 0.7, z 0 .. 0.3: beside the table, well inside the mast's view (a
+    # voxel is judged by its centre in frustum mode: one straddling the image border is cleared
+    # only once its centre is in view).
+    gone = Box((1.6, 0.6, 0.15), (0.1, 0.1, 0.15))
+    cam = DepthCamera()
+    pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
+    vmap = dp.VoxelMap(room_config(), -2.0, -2.0, 80, 80)
+    mast = look_at(np.array([-0.6, 0.0, 1.8]), np.array([0.8, 0.0, 0.75]))
+    with_box = Scene3D(boxes=[table, gone])
+    vmap.integrate_depth(
+        cam.render(with_box, mast), pinhole, mast, 0.0, rays(), False, 1, clearing_mode
+    )
+    box_column = (72, 52)  # x 1.60 .. 1.65, y 0.60 .. 0.65
+    assert vmap.project(0.0)[box_column[1], box_column[0]] == LETHAL
+    low = look_at(np.array([-0.6, 0.0, 0.3]), np.array([0.8, 0.0, 0.1]))
+    scene = Scene3D(boxes=[table])
+    for k in range(1, 11):
+        view = mast if k % 2 else low
+        vmap.integrate_depth(
+            cam.render(scene, view), pinhole, view, float(k), rays(), False, 1, clearing_mode
+        )
+    costs = vmap.project(10.0)
+    assert (costs[(40 - 6) : (40 + 6), (40 + 10) : (40 + 22)] == LETHAL).all()
+    assert vmap.state(56, 40, 4, 10.0) == 0  # under the top
+    assert vmap.state(56, 40, 15, 10.0) == 1  # the top
+    assert costs[box_column[1], box_column[0]] != LETHAL  # the box is gone
+
+
+def test_unknown_clearing_mode_is_refused() -> None:
+    cam = DepthCamera()
+    pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
+    vmap = dp.VoxelMap(room_config(), -2.0, -2.0, 80, 80)
+    depth = np.ones((cam.height, cam.width), dtype=np.float32)
+    with pytest.raises(ValueError, match="clearing_mode"):
+        vmap.integrate_depth(depth, pinhole, np.eye(4), 0.0, rays(), False, 1, "cone")

@@ -12,6 +12,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -53,6 +54,7 @@ class VoxelObstacleLayer : public Layer {
     std::string sensor_frame;       ///< overrides the message's frame_id when set
     bool depth = false;             ///< DepthImage, else PointCloud2
     bool zero_is_no_return = false;
+    bool frustum = false;  ///< clearing_mode frustum (depth sources)
     int stride = 1;
     int tf_queue_size = 20;
     VoxelRayConfig rays;
@@ -78,6 +80,11 @@ class VoxelObstacleLayer : public Layer {
   bool lookup(Source* s, const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
   void integrate(Source* s, const Eigen::Vector3d& origin, const std::vector<float>& hits,
                  const std::vector<float>& no_returns, const ros::Time& stamp);
+  void integrateFrustum(Source* s, const std::vector<float>& metres, const PinholeCamera& camera,
+                        const Eigen::Isometry3d& pose, const ros::Time& stamp);
+  /// Runs one integration under the lock and books its result (timing, counts, dirty window).
+  void runIntegration(Source* s, const ros::Time& stamp,
+                      const std::function<VoxelIntegrationStats()>& work);
   void publishVoxels(const ros::Time& stamp);
 
   std::mutex mutex_;

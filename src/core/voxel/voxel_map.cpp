@@ -309,6 +309,24 @@ void VoxelMap::clearRay(const double p0[3], const double p1[3], bool include_end
   stats->voxels_walked += static_cast<std::size_t>(n);
 }
 
+float VoxelMap::beginFrame(double stamp_s) {
+  if (!has_epoch_) {
+    // Stamps are kept as float seconds since the first frame: 1 ms resolution for ~4.6 hours.
+    epoch_s_ = stamp_s;
+    has_epoch_ = true;
+  }
+  if (++frame_ == 0) {
+    // 2^32 frames: reset the tags so that no voxel looks updated by the new frame already.
+    for (auto& b : table_) {
+      if (!b) continue;
+      std::fill(std::begin(b->frame), std::end(b->frame), 0u);
+      std::fill(std::begin(b->ray_frame), std::end(b->ray_frame), 0u);
+    }
+    frame_ = 1;
+  }
+  return static_cast<float>(stamp_s - epoch_s_);
+}
+
 VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const float* hits,
                                           std::size_t n_hits, const float* no_returns,
                                           std::size_t n_no_returns, double stamp_s,
@@ -322,21 +340,7 @@ VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const f
   }
   VoxelIntegrationStats stats;
   stats.rays = n_hits + n_no_returns;
-  if (!has_epoch_) {
-    // Stamps are kept as float seconds since the first frame: 1 ms resolution for ~4.6 hours.
-    epoch_s_ = stamp_s;
-    has_epoch_ = true;
-  }
-  const auto stamp = static_cast<float>(stamp_s - epoch_s_);
-  if (++frame_ == 0) {
-    // 2^32 frames: reset the tags so that no voxel looks updated by the new frame already.
-    for (auto& b : table_) {
-      if (!b) continue;
-      std::fill(std::begin(b->frame), std::end(b->frame), 0u);
-      std::fill(std::begin(b->ray_frame), std::end(b->ray_frame), 0u);
-    }
-    frame_ = 1;
-  }
+  const float stamp = beginFrame(stamp_s);
   const double res = config_.resolution_m;
   const double zres = config_.z_resolution_m;
   const double ox = windowOriginX();

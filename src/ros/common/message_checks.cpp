@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "downstream_perception/core/costmap/scan_integrator.h"
@@ -178,7 +179,7 @@ bool checkDepthImage(const sensor_msgs::Image& image, std::string* why) {
 }
 
 bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
-                        std::string* why) {
+                        std::string* why, bool zero_is_no_return) {
   if (!checkDepthImage(image, why)) return false;
   const bool is_float = image.encoding == sensor_msgs::image_encodings::TYPE_32FC1;
   metres->resize(static_cast<std::size_t>(image.width) * image.height);
@@ -191,6 +192,11 @@ bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* met
     } else {
       std::memcpy(mm.data(), row, image.width * sizeof(std::uint16_t));
       millimetresToMetres(mm.data(), mm.size(), out);
+      if (zero_is_no_return) {
+        for (std::size_t u = 0; u < mm.size(); ++u) {
+          if (mm[u] == 0) out[u] = std::numeric_limits<float>::infinity();
+        }
+      }
     }
   }
   return true;

@@ -178,6 +178,10 @@ TEST(CheckDepthImage, AcceptsMetresAndMillimetres) {
   ASSERT_EQ(metres.size(), 2u);
   EXPECT_FLOAT_EQ(metres[0], 1.5f);
   EXPECT_TRUE(std::isnan(metres[1]));  // 0 mm = no measurement
+  // A driver's 0 for "too far", asked for as a no-return: +Inf (REP 118), not NaN (invalid).
+  ASSERT_TRUE(depthImageToMetres(mm, &metres, &why, true)) << why;
+  EXPECT_FLOAT_EQ(metres[0], 1.5f);
+  EXPECT_EQ(metres[1], std::numeric_limits<float>::infinity());
 }
 
 TEST(CheckDepthImage, RefusesInconsistentSizes) {

@@ -25,7 +25,10 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "downstream_perception/core/grid/grid_geometry.h"
+#include "downstream_perception/core/tsdf/tsdf_integrator.h"  // PinholeCamera
 #include "downstream_perception/core/voxel/voxel_config.h"
 
 namespace downstream_perception {
@@ -92,6 +95,23 @@ class VoxelMap {
                                   std::size_t n_no_returns, double stamp_s,
                                   const VoxelRayConfig& rays);
 
+  /// Integrates one depth image (REP 118 metres, row-major, camera.width x camera.height) with
+  /// frustum clearing, as the spatio-temporal voxel layer clears: every `stride`-th pixel's
+  /// return within obstacle range marks its voxel (hits first, as in integrate()); then every
+  /// window voxel whose centre lies in the camera's view, in front of the camera, and nearer along
+  /// the optical axis than the depth of the pixel it projects to by more than half its diagonal
+  /// gets one miss, if within raytrace_max_range_m of the camera (a no-return pixel: +Inf, or 0
+  /// with zero_is_no_return, clears to no_return_range_m; an invalid pixel clears nothing).
+  /// Voxels behind what the camera sees, outside the image or behind the camera keep their
+  /// state, seen or not. Unlike ray clearing, every pixel clears, whatever the stride, and the
+  /// cost grows with the voxels in view, not with the pixels times their range. Throws
+  /// std::invalid_argument for an invalid camera, stride < 1, a null image, a non-finite pose or
+  /// stamp, or an invalid ray config.
+  VoxelIntegrationStats integrateDepthFrustum(const float* depth_m, const PinholeCamera& camera,
+                                              const Eigen::Isometry3d& T_world_camera,
+                                              bool zero_is_no_return, int stride, double stamp_s,
+                                              const VoxelRayConfig& rays);
+
   /// Log-odds of a window voxel at time now_s (decay applied); 0 for an unseen or outside voxel.
   double logOdds(int x, int y, int z, double now_s) const;
   VoxelState state(int x, int y, int z, double now_s) const;
@@ -138,6 +158,11 @@ class VoxelMap {
   void update(int x, int y, int z, float delta, float stamp, VoxelIntegrationStats* stats);
   void updateVoxel(VoxelBlock* b, int v, int x, int y, float delta, float stamp,
                    VoxelIntegrationStats* stats);
+  /// Starts an integrate() frame: the epoch on the first, the frame tag; the stamp as stored.
+  float beginFrame(double stamp_s);
+  void clearFrustum(const float* depth_m, const PinholeCamera& camera,
+                    const Eigen::Isometry3d& T_world_camera, bool zero_is_no_return,
+                    const VoxelRayConfig& rays, float stamp, VoxelIntegrationStats* stats);
   void clearRay(const double p0[3], const double p1[3], bool include_end, float stamp,
                 bool one_per_end_voxel, VoxelIntegrationStats* stats);
 

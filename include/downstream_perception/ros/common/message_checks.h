@@ -34,9 +34,11 @@ std::string checkOccupancyGrid(const nav_msgs::OccupancyGrid& msg);
 bool checkDepthImage(const sensor_msgs::Image& image, std::string* why);
 
 /// A depth image as metres (32FC1 as is, 16UC1 millimetres converted, 0 -> NaN), after
-/// checkDepthImage() (false with its reason).
+/// checkDepthImage() (false with its reason). With zero_is_no_return, a 16UC1 0 becomes +Inf
+/// (REP 118's no return) instead: drivers that write 0 for "too far" (a 32FC1 0 stays 0, which
+/// the consumers read as a no-return under the same setting).
 bool depthImageToMetres(const sensor_msgs::Image& image, std::vector<float>* metres,
-                        std::string* why);
+                        std::string* why, bool zero_is_no_return = false);
 
 /// Calls visit(x, y, z) (floats, NaN passed on) for each point of a cloud that passed
 /// checkCloudLayout, which gave x_offset. Reads through the checked row_step and point_step only,
