@@ -145,8 +145,40 @@ constexpr int kBlock = 1 << kBlockShift;
 // every ray. Scan benchmark, 1000^2: 360 and 1080 beams (ratio 0.22, 0.67) gain nothing or lose
 // up to 1.4x (counting the blocks entered costs more than the few skips save); 3600 beams
 // (ratio 2.2) gain 1.8x.
+// And only where blocks can be skipped at all: on a grid that has not seen this area yet (the
+// first scan after start-up, a reset or a resize) no cell is saturated free and counting the
+// blocks is pure cost (first scan 1.4x slower than per ray). A 16 x 16 sample of the box decides.
 constexpr std::size_t kAutoBlockWalkNumerator = 1;
 constexpr std::size_t kAutoBlockWalkDenominator = 1;
+constexpr double kAutoMinSaturatedShare = 0.25;
+constexpr int kSaturationSamples = 16;  // per axis
+
+// Share of the box's cells (a regular sample) that sit at the lower clamp.
+double saturatedFreeShare(const ScanCells& sc, const CellBounds& box) {
+  const int w = box.max_x - box.min_x + 1;
+  const int h = box.max_y - box.min_y + 1;
+  const int nx = std::min(w, kSaturationSamples);
+  const int ny = std::min(h, kSaturationSamples);
+  int saturated = 0;
+  for (int j = 0; j < ny; ++j) {
+    const std::ptrdiff_t y = box.min_y + static_cast<std::ptrdiff_t>(j) * h / ny + h / (2 * ny);
+    for (int i = 0; i < nx; ++i) {
+      const std::ptrdiff_t x = box.min_x + static_cast<std::ptrdiff_t>(i) * w / nx + w / (2 * nx);
+      saturated += (sc.cells[y * sc.size_x + x] & ~1) == (sc.saturated_free_raw & ~1);
+    }
+  }
+  return static_cast<double>(saturated) / (nx * ny);
+}
+
+}  // namespace
+
+bool autoChoosesBlockWalk(std::size_t ray_cells, std::size_t box_cells,
+                          double saturated_free_share) {
+  return ray_cells * kAutoBlockWalkDenominator > box_cells * kAutoBlockWalkNumerator &&
+         saturated_free_share >= kAutoMinSaturatedShare;
+}
+
+namespace {
 
 // The per-scan block state of the block walk (see the file comment).
 struct Blocks {
@@ -354,8 +386,8 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                                     : static_cast<std::size_t>(box.max_x - box.min_x + 1) *
                                           static_cast<std::size_t>(box.max_y - box.min_y + 1);
   const bool use_blocks = walk_kind == ClearingWalk::kBlockSkip ||
-                          (walk_kind == ClearingWalk::kAuto &&
-                           steps * kAutoBlockWalkDenominator > box_cells * kAutoBlockWalkNumerator);
+                          (walk_kind == ClearingWalk::kAuto && !box.empty() &&
+                           autoChoosesBlockWalk(steps, box_cells, saturatedFreeShare(sc, box)));
   if (use_blocks) {
     const int bx = static_cast<int>((geometry.sizeX() + kBlock - 1) >> kBlockShift);
     const int by = static_cast<int>((geometry.sizeY() + kBlock - 1) >> kBlockShift);

@@ -209,3 +209,15 @@ TEST(ScanClearing, ScratchFollowsAChangeOfGridSize) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]);
   }
 }
+
+TEST(ScanClearing, AutoTakesTheBlockWalkOnlyForDenseRaysOverSeenSpace) {
+  // Dense rays (twice the box's cells) over a box a quarter or more saturated free: blocks.
+  EXPECT_TRUE(autoChoosesBlockWalk(2000, 1000, 0.25));
+  EXPECT_TRUE(autoChoosesBlockWalk(2000, 1000, 1.0));
+  // The same rays on a grid that has not seen the area (a first scan): per ray.
+  EXPECT_FALSE(autoChoosesBlockWalk(2000, 1000, 0.0));
+  EXPECT_FALSE(autoChoosesBlockWalk(2000, 1000, 0.24));
+  // Sparse rays (fewer cells than the box): per ray, saturated or not.
+  EXPECT_FALSE(autoChoosesBlockWalk(1000, 1000, 1.0));
+  EXPECT_FALSE(autoChoosesBlockWalk(10, 1000, 1.0));
+}

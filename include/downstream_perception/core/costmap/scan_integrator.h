@@ -87,6 +87,13 @@ enum class ClearingWalk {
   kBlockSkip,
 };
 
+/// ClearingWalk::kAuto's choice, from the rays' cells (steps summed over the rays), the cells of
+/// the box they touch and the share of a sample of that box already saturated free: the block
+/// walk when the rays cross the box more than once over and at least a quarter of it is
+/// saturated (else no block could be skipped: a first scan).
+bool autoChoosesBlockWalk(std::size_t ray_cells, std::size_t box_cells,
+                          double saturated_free_share);
+
 /// One clearing ray of a scan, set up before any is walked.
 struct ClearingRay {
   RayWalk walk;
