@@ -1,0 +1,116 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "downstream_perception/core/voxel/scan_rays.h"
+#include "downstream_perception/core/voxel/voxel_map.h"
+
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Beams every 45 degrees from 0; range_min 0.1, range_max 5.
+const std::vector<float> kRanges = {1.0f, kInf, std::nanf(""), -kInf, 0.05f, 7.0f, 5.0f};
+
+LaserScanView view() {
+  LaserScanView s;
+  s.ranges = kRanges.data();
+  s.count = kRanges.size();
+  s.angle_min = 0.0;
+  s.angle_increment = M_PI / 4;
+  s.range_min = 0.1;
+  s.range_max = 5.0;
+  return s;
+}
+
+// The sensor at (1, 2, 0.5), turned 90 degrees left: its x is the world's y.
+Eigen::Isometry3d pose() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).matrix();
+  T.translation() = Eigen::Vector3d(1.0, 2.0, 0.5);
+  return T;
+}
+
+void expectPoint(const std::vector<float>& v, std::size_t i, double x, double y, double z) {
+  ASSERT_GE(v.size(), 3 * i + 3);
+  EXPECT_NEAR(v[3 * i], x, 1e-5);
+  EXPECT_NEAR(v[3 * i + 1], y, 1e-5);
+  EXPECT_NEAR(v[3 * i + 2], z, 1e-5);
+}
+
+}  // namespace
+
+TEST(ScanRays, Rep117HandWorked) {
+  DepthRays out;
+  scanToRays(view(), pose(), true, false, &out);
+  // Beam 0 (sensor +x = world +y) returns at 1 m: (1, 3, 0.5). Beam 6 (270 deg = sensor -y =
+  // world +x) at range_max 5 m is a return: (6, 2, 0.5).
+  ASSERT_EQ(out.hits.size(), 6u);
+  expectPoint(out.hits, 0, 1.0, 3.0, 0.5);
+  expectPoint(out.hits, 1, 6.0, 2.0, 0.5);
+  // Beam 1 (+Inf, 45 deg): a no-return 1 m along, sensor (0.7071, 0.7071) = world (-0.7071,
+  // 0.7071) from (1, 2).
+  ASSERT_EQ(out.no_returns.size(), 3u);
+  expectPoint(out.no_returns, 0, 1.0 - std::sqrt(0.5), 2.0 + std::sqrt(0.5), 0.5);
+  // NaN, -Inf, 0.05 < range_min, 7 > range_max.
+  EXPECT_EQ(out.invalid, 4u);
+  // Without inf_is_valid +Inf is skipped; with range_max_is_no_return beam 6 is a no-return
+  // 1 m along world +x: (2, 2, 0.5).
+  scanToRays(view(), pose(), false, true, &out);
+  EXPECT_EQ(out.hits.size(), 3u);
+  ASSERT_EQ(out.no_returns.size(), 3u);
+  expectPoint(out.no_returns, 0, 2.0, 2.0, 0.5);
+  EXPECT_EQ(out.invalid, 5u);
+}
+
+TEST(ScanRays, UpsideDownScannerMirrorsTheFan) {
+  // Rolled 180 degrees: the beam at +90 degrees goes to world -y.
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).matrix();
+  const std::vector<float> r = {2.0f};
+  LaserScanView s = view();
+  s.ranges = r.data();
+  s.count = 1;
+  s.angle_min = M_PI / 2;
+  DepthRays out;
+  scanToRays(s, T, true, false, &out);
+  expectPoint(out.hits, 0, 0.0, -2.0, 0.0);
+}
+
+TEST(ScanRays, IntoTheVoxelMapMarksAndClears) {
+  // 10 cm voxels; the scanner at (0.05, 0.55, 0.55) sees a return 1 m ahead along +x.
+  VoxelMapConfig c;
+  c.resolution_m = 0.1;
+  c.z_resolution_m = 0.1;
+  c.z_voxels = 10;
+  VoxelMap map(c, 0.0, 0.0, 20, 20);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(0.05, 0.55, 0.55);
+  const std::vector<float> r = {1.0f};
+  LaserScanView s = view();
+  s.ranges = r.data();
+  s.count = 1;
+  DepthRays out;
+  scanToRays(s, T, true, false, &out);
+  VoxelRayConfig rays;
+  map.integrate(T.translation(), out.hits.data(), out.hits.size() / 3, out.no_returns.data(),
+                out.no_returns.size() / 3, 0.0, rays);
+  EXPECT_EQ(map.state(10, 5, 5, 0.0), VoxelState::kOccupied);  // x 1.0 .. 1.1 holds 1.05
+  EXPECT_EQ(map.state(5, 5, 5, 0.0), VoxelState::kFree);
+  EXPECT_EQ(map.state(5, 5, 4, 0.0), VoxelState::kUnknown);  // below the beam's plane
+}
+
+TEST(ScanRays, InvalidScanRefused) {
+  LaserScanView s = view();
+  s.angle_increment = 0.0;
+  DepthRays out;
+  EXPECT_THROW(scanToRays(s, pose(), true, false, &out), std::invalid_argument);
+  Eigen::Isometry3d T = pose();
+  T.translation().x() = std::nan("");
+  EXPECT_THROW(scanToRays(view(), T, true, false, &out), std::invalid_argument);
+}
