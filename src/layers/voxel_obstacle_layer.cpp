@@ -11,6 +11,7 @@
 
 #include "downstream_perception/core/grid/cost_values.h"
 #include "downstream_perception/core/voxel/depth_rays.h"
+#include "downstream_perception/core/voxel/scan_rays.h"
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/common/param_reader.h"
 #include "downstream_perception/ros/common/timing_diagnostics.h"
@@ -130,12 +131,18 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   reader.unsupported("max_obstacle_height", "see min_obstacle_height");
   reader.unsupported("observation_persistence", "each observation is integrated once");
   reader.unsupported("expected_update_rate", "not checked by this layer");
-  reader.unsupported("inf_is_valid", "depth images: +Inf is a no-return ray (REP 118)");
+  if (data_type == "LaserScan") {
+    // costmap_2d's key and default: +Inf beams clear (to no_return_range) only when set.
+    reader.get("inf_is_valid", &s->inf_is_valid);
+    reader.get("range_max_is_no_return", &s->range_max_is_no_return);
+  } else {
+    reader.unsupported("inf_is_valid", "depth images: +Inf is a no-return ray (REP 118)");
+  }
   reader.warnUnknown();
   for (const auto& w : reader.warnings()) param_warnings_.push_back("source '" + name + "': " + w);
   std::string why = s->rays.validate();
-  if (data_type != "PointCloud2" && data_type != "DepthImage") {
-    why = "data_type '" + data_type + "' is not supported (PointCloud2 or DepthImage)";
+  if (data_type != "PointCloud2" && data_type != "DepthImage" && data_type != "LaserScan") {
+    why = "data_type '" + data_type + "' is not supported (PointCloud2, DepthImage or LaserScan)";
   } else if (clearing_mode != "ray" && clearing_mode != "frustum") {
     why = "clearing_mode '" + clearing_mode + "' is not supported (ray or frustum)";
   } else if (clearing_mode == "frustum" && data_type != "DepthImage") {
@@ -153,6 +160,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   }
   s->depth = data_type == "DepthImage";
   s->frustum = clearing_mode == "frustum";
+  s->scan = data_type == "LaserScan";
   if (s->depth && s->camera_info_topic.empty()) {
     // image_transport's convention: the camera_info next to the image.
     const std::size_t slash = s->topic.rfind('/');
@@ -189,6 +197,14 @@ void VoxelObstacleLayer::activate() {
                        tf2_ros::filter_failure_reasons::FilterFailureReason r) {
             on_failure(m, r);
           });
+    } else if (s->scan) {
+      s->scan_sub.subscribe(
+          topic_nh_, s->topic, *tf_, frame, s->tf_queue_size,
+          [this, s](const sensor_msgs::LaserScanConstPtr& m) { onScan(s, m); },
+          [on_failure](const sensor_msgs::LaserScanConstPtr& m,
+                       tf2_ros::filter_failure_reasons::FilterFailureReason r) {
+            on_failure(m, r);
+          });
     } else {
       s->cloud_sub.subscribe(
           topic_nh_, s->topic, *tf_, frame, s->tf_queue_size,
@@ -205,6 +221,7 @@ void VoxelObstacleLayer::deactivate() {
   for (auto& s : sources_) {
     s->cloud_sub.unsubscribe();
     s->depth_sub.unsubscribe();
+    s->scan_sub.unsubscribe();
     s->info_sub.shutdown();
   }
 }
@@ -288,6 +305,29 @@ void VoxelObstacleLayer::onDepth(Source* s, const sensor_msgs::ImageConstPtr& ms
   }
   DepthRays rays;
   depthToRays(metres.data(), *cam, pose, s->zero_is_no_return, s->stride, &rays);
+  integrate(s, pose.translation(), rays.hits, rays.no_returns, msg->header.stamp);
+}
+
+void VoxelObstacleLayer::onScan(Source* s, const sensor_msgs::LaserScanConstPtr& msg) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++s->received;
+  }
+  const LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
+                           msg->angle_increment, msg->range_min,     msg->range_max};
+  const std::string why = view.validate();
+  if (!why.empty()) {
+    reject(s, "laser scan: " + why);
+    return;
+  }
+  // One pose for the sweep (no per-beam time correction here, unlike the obstacle layer).
+  Eigen::Isometry3d pose;
+  if (!lookup(s, s->sensor_frame.empty() ? msg->header.frame_id : s->sensor_frame,
+              msg->header.stamp, &pose)) {
+    return;
+  }
+  DepthRays rays;
+  scanToRays(view, pose, s->inf_is_valid, s->range_max_is_no_return, &rays);
   integrate(s, pose.translation(), rays.hits, rays.no_returns, msg->header.stamp);
 }
 

@@ -1,15 +1,17 @@
 // downstream_perception/VoxelObstacleLayer: a 3-D voxel obstacle layer with costmap_2d
-// VoxelLayer's keys and meaning. PointCloud2 and depth-image sources, each transformed at its own
-// stamp (tf2 MessageFilter), mark and clear a sparse 3-D log-odds voxel map (core/voxel) over the
-// costmap's window with exact 3-D ray traversal: a ray that passes under a table top does not
-// erase it. Each column within the robot's height band is projected into the master with
-// costmap_2d's rule (more than mark_threshold occupied voxels: lethal; at most unknown_threshold
-// unknown voxels: known, so free). The occupied voxels can be published as a PointCloud2.
+// VoxelLayer's keys and meaning. PointCloud2, depth-image and LaserScan sources, each transformed
+// at its own stamp (tf2 MessageFilter), mark and clear a sparse 3-D log-odds voxel map
+// (core/voxel) over the costmap's window with exact 3-D ray traversal (or, per depth source,
+// frustum clearing): a ray that passes under a table top does not erase it. Each column within
+// the robot's height band is projected into the master with costmap_2d's rule (more than
+// mark_threshold occupied voxels: lethal; at most unknown_threshold unknown voxels: known, so
+// free). The occupied voxels can be published as a PointCloud2.
 #pragma once
 
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <functional>
@@ -50,9 +52,12 @@ class VoxelObstacleLayer : public Layer {
   struct Source {
     std::string name;
     std::string topic;
-    std::string camera_info_topic;  ///< depth sources
-    std::string sensor_frame;       ///< overrides the message's frame_id when set
-    bool depth = false;             ///< DepthImage, else PointCloud2
+    std::string camera_info_topic;        ///< depth sources
+    std::string sensor_frame;             ///< overrides the message's frame_id when set
+    bool depth = false;                   ///< DepthImage
+    bool scan = false;                    ///< LaserScan (neither: PointCloud2)
+    bool inf_is_valid = false;            ///< LaserScan: +Inf is a no-return ray (costmap_2d's key)
+    bool range_max_is_no_return = false;  ///< LaserScan: range_max is a no-return ray
     bool zero_is_no_return = false;
     bool frustum = false;  ///< clearing_mode frustum (depth sources)
     int stride = 1;
@@ -60,6 +65,7 @@ class VoxelObstacleLayer : public Layer {
     VoxelRayConfig rays;
     FilteredSubscription<sensor_msgs::PointCloud2> cloud_sub;
     FilteredSubscription<sensor_msgs::Image> depth_sub;
+    FilteredSubscription<sensor_msgs::LaserScan> scan_sub;
     ros::Subscriber info_sub;
     // Guarded by the layer's mutex_.
     std::optional<PinholeCamera> camera;
@@ -74,6 +80,7 @@ class VoxelObstacleLayer : public Layer {
   void readSource(const std::string& name);
   void onCloud(Source* s, const sensor_msgs::PointCloud2ConstPtr& msg);
   void onDepth(Source* s, const sensor_msgs::ImageConstPtr& msg);
+  void onScan(Source* s, const sensor_msgs::LaserScanConstPtr& msg);
   void onCameraInfo(Source* s, const sensor_msgs::CameraInfoConstPtr& msg);
   void reject(Source* s, const std::string& why);
   /// sensor -> global at the stamp; false (and a rejection) when tf cannot give it.

@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""rostest: a LaserScan source of the VoxelObstacleLayer marks, clears and leaves unseen space
+unknown.
+
+The scanner sits 0.3 m above the odom origin looking along +x with beams from -90 to +90 degrees.
+A wall at x = 1.525 m answers the beams within 60 degrees of the axis; the others see nothing (+Inf,
+inf_is_valid: they clear to raytrace_range, 3 m).
+"""
+
+from __future__ import annotations
+
+import math
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from sensor_msgs.msg import LaserScan
+from tf2_ros import StaticTransformBroadcaster
+
+from downstream_perception.ros.costmap_client import CostmapClient
+from downstream_perception.ros.util import laser_scan, transform_stamped, wait_until
+
+LETHAL, FREE, UNKNOWN = 100, 0, -1
+ANGLES = np.radians(np.arange(-90.0, 90.5, 1.0))
+
+
+def wall_ranges(wall: bool) -> np.ndarray:
+    ranges = np.full(ANGLES.shape, math.inf)
+    if wall:
+        near = np.abs(ANGLES) < math.radians(60.0)
+        ranges[near] = 1.525 / np.cos(ANGLES[near])  # mid-voxel: no rounding at a face
+    return ranges
+
+
+class VoxelLayerScanTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node("test_voxel_layer_scan")
+        cls.static_tf = StaticTransformBroadcaster()
+        now = rospy.Time.now()
+        cls.static_tf.sendTransform(
+            [
+                transform_stamped("odom", "base_link", now),
+                transform_stamped("odom", "laser", now, z=0.3),
+            ]
+        )
+        cls.pub = rospy.Publisher("/scan", LaserScan, queue_size=5)
+        cls.costmap = CostmapClient("/costmap/costmap")
+
+    def publish(self, wall: bool, seconds: float) -> None:
+        rate = rospy.Rate(5.0)
+        end = rospy.Time.now() + rospy.Duration(seconds)
+        while rospy.Time.now() < end and not rospy.is_shutdown():
+            msg = laser_scan(
+                rospy.Time.now(),
+                "laser",
+                wall_ranges(wall),
+                float(ANGLES[0]),
+                math.radians(1.0),
+                0.05,
+                10.0,
+            )
+            self.pub.publish(msg)
+            rate.sleep()
+        rospy.sleep(1.0)  # a costmap update and publish after the last scan
+
+    def test_wall_marked_space_cleared_then_wall_removed(self) -> None:
+        self.assertTrue(wait_until(lambda: self.pub.get_num_connections() > 0, 20.0))
+        self.publish(wall=True, seconds=2.0)
+        self.assertTrue(wait_until(lambda: self.costmap.received, 10.0), "no costmap")
+        self.assertEqual(self.costmap.cell(1.52, 0.0), LETHAL)
+        self.assertEqual(self.costmap.cell(1.52, 0.5), LETHAL)
+        self.assertEqual(self.costmap.cell(0.8, 0.0), FREE)  # between the scanner and the wall
+        # On the +Inf beam at 75 degrees, 1.5 m out: (0.388, 1.449). (Not the 90-degree beam: its
+        # float32 angle puts it a hair either side of the column face at x = 0.)
+        self.assertEqual(self.costmap.cell(0.388, 1.449), FREE)
+        self.assertEqual(self.costmap.cell(-1.0, 0.0), UNKNOWN)  # behind the scanner: unseen
+        # The wall is gone: every beam sees nothing; 15 misses clear its voxels.
+        self.publish(wall=False, seconds=3.0)
+        self.assertEqual(self.costmap.cell(1.52, 0.0), FREE)
+        self.assertEqual(self.costmap.cell(2.5, 0.0), FREE)  # beyond the wall, now seen
+
+
+if __name__ == "__main__":
+    rostest.rosrun("downstream_perception", "test_voxel_layer_scan", VoxelLayerScanTest)
