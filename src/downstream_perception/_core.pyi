@@ -1964,9 +1964,10 @@ class VoxelMap:
         rays: VoxelRayConfig,
         zero_is_no_return: bool = False,
         stride: typing.SupportsInt | typing.SupportsIndex = 1,
+        clearing_mode: str = "ray",
     ) -> dict:
         """
-        A depth image (metres, REP 118: +Inf = no return) as one frame.
+        A depth image (metres, REP 118: +Inf = no return) as one frame. clearing_mode 'ray': every stride-th pixel's ray clears the voxels it crosses (exact 3-D traversal); 'frustum': every voxel in view nearer than the depth of the pixel it projects to (by more than half its diagonal) gets a miss, the spatio-temporal voxel layer's way, and every stride-th pixel marks. invalid_pixels is counted in 'ray' mode only.
         """
     def log_odds(
         self,
