@@ -160,6 +160,8 @@ void VoxelMap::clearFrustum(const float* depth_m, const PinholeCamera& camera,
   const double block_radius =
       0.5 * std::sqrt(2.0 * (kE * res) * (kE * res) + (kE * zres) * (kE * zres));
   std::size_t visited = 0;
+  const bool skip_saturated = config_.decay_time_s <= 0.0;
+  const auto clamp_min = static_cast<float>(config_.log_odds.clamp_min);
   for (int bz = iz0 / kE; bz <= iz1 / kE; ++bz) {
     for (int by = (iy0 + y0_) >> VoxelBlock::kEdgeShift;
          by <= (iy1 + y0_) >> VoxelBlock::kEdgeShift; ++by) {
@@ -202,6 +204,13 @@ void VoxelMap::clearFrustum(const float* depth_m, const PinholeCamera& camera,
                 clear = r2 <= none2;
               }
               if (!clear) continue;
+              // Already saturated free and nothing decays: another miss changes nothing, so it
+              // is not written (nor reported as touched: the costmap would redraw the whole
+              // view every frame).
+              if (skip_saturated && block != nullptr &&
+                  block->log_odds[voxelIndex(x + x0_, y + y0_, z)] <= clamp_min) {
+                continue;
+              }
               if (block == nullptr) {
                 block = ensureBlock(x, y, z);
                 if (block == nullptr) {

@@ -199,3 +199,22 @@ TEST(VoxelFrustum, BadInputIsRefused) {
   EXPECT_EQ(s.cleared + s.marked, 0u);
   EXPECT_EQ(map.blocks(), 0u);
 }
+
+TEST(VoxelFrustum, SaturatedFreeVoxelsAreNotRewritten) {
+  // Five misses take a voxel to the clamp (-0.405 x 5 < -2). From the sixth frame of the same
+  // view on, nothing in front of the wall changes: nothing is cleared or reported touched but
+  // the wall's own columns. With decay on, every frame rewrites them (their stamps matter).
+  VoxelMap map(config(), 0.0, 0.0, 40, 40);
+  const std::vector<float> wall = render({}, 2.02);
+  for (int k = 0; k < 6; ++k) frame(&map, wall, 0.1 * k);
+  const VoxelIntegrationStats s = frame(&map, wall, 0.6);
+  EXPECT_EQ(s.cleared, 0u);
+  EXPECT_GT(s.marked, 0u);
+  EXPECT_GE(s.touched.min_x, 19);  // only the wall's voxels (x index 19 .. 20)
+  EXPECT_NEAR(map.logOdds(10, 20, 10, 0.6), -2.0, 1e-6);
+  VoxelMapConfig decaying = config();
+  decaying.decay_time_s = 100.0;
+  VoxelMap fading(decaying, 0.0, 0.0, 40, 40);
+  for (int k = 0; k < 6; ++k) frame(&fading, wall, 0.1 * k);
+  EXPECT_GT(frame(&fading, wall, 0.6).cleared, 100u);
+}
