@@ -132,9 +132,20 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   reader.unsupported("observation_persistence", "each observation is integrated once");
   reader.unsupported("expected_update_rate", "not checked by this layer");
   if (data_type == "LaserScan") {
-    // costmap_2d's key and default: +Inf beams clear (to no_return_range) only when set.
-    reader.get("inf_is_valid", &s->inf_is_valid);
-    reader.get("range_max_is_no_return", &s->range_max_is_no_return);
+    // costmap_2d's inf_is_valid keeps its meaning (+Inf: a return at range_max); ours,
+    // inf_is_no_return (REP-117), wins when both are set, with a WARN.
+    reader.get("inf_is_valid", &s->scan_options.inf_is_valid);
+    reader.get("inf_is_no_return", &s->scan_options.inf_is_no_return);
+    reader.get("range_max_is_no_return", &s->scan_options.range_max_is_no_return);
+    if (s->scan_options.inf_is_valid && s->scan_options.inf_is_no_return) {
+      const std::string msg =
+          "source '" + name +
+          "': inf_is_valid (costmap_2d: +Inf is a return at range_max) and inf_is_no_return "
+          "(ours: +Inf clears to no_return_range, never marks) are both set; using "
+          "inf_is_no_return";
+      ROS_WARN("layer '%s': %s", name_.c_str(), msg.c_str());
+      param_warnings_.push_back(msg);
+    }
   } else {
     reader.unsupported("inf_is_valid", "depth images: +Inf is a no-return ray (REP 118)");
   }
@@ -313,13 +324,14 @@ void VoxelObstacleLayer::onScan(Source* s, const sensor_msgs::LaserScanConstPtr&
     std::lock_guard<std::mutex> lock(mutex_);
     ++s->received;
   }
-  const LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
-                           msg->angle_increment, msg->range_min,     msg->range_max};
-  const std::string why = view.validate();
+  // The shared message check (sizes and offsets in 64 bits, the sweep's duration, intensities).
+  const std::string why = checkScan(*msg);
   if (!why.empty()) {
     reject(s, "laser scan: " + why);
     return;
   }
+  const LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
+                           msg->angle_increment, msg->range_min,     msg->range_max};
   // One pose for the sweep (no per-beam time correction here, unlike the obstacle layer).
   Eigen::Isometry3d pose;
   if (!lookup(s, s->sensor_frame.empty() ? msg->header.frame_id : s->sensor_frame,
@@ -327,7 +339,7 @@ void VoxelObstacleLayer::onScan(Source* s, const sensor_msgs::LaserScanConstPtr&
     return;
   }
   DepthRays rays;
-  scanToRays(view, pose, s->inf_is_valid, s->range_max_is_no_return, &rays);
+  scanToRays(view, pose, s->scan_options, &rays);
   integrate(s, pose.translation(), rays.hits, rays.no_returns, msg->header.stamp);
 }
 

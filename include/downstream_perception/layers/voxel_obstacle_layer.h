@@ -23,6 +23,7 @@
 
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
+#include "downstream_perception/core/voxel/scan_rays.h"
 #include "downstream_perception/core/voxel/voxel_map.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
@@ -52,12 +53,11 @@ class VoxelObstacleLayer : public Layer {
   struct Source {
     std::string name;
     std::string topic;
-    std::string camera_info_topic;        ///< depth sources
-    std::string sensor_frame;             ///< overrides the message's frame_id when set
-    bool depth = false;                   ///< DepthImage
-    bool scan = false;                    ///< LaserScan (neither: PointCloud2)
-    bool inf_is_valid = false;            ///< LaserScan: +Inf is a no-return ray (costmap_2d's key)
-    bool range_max_is_no_return = false;  ///< LaserScan: range_max is a no-return ray
+    std::string camera_info_topic;  ///< depth sources
+    std::string sensor_frame;       ///< overrides the message's frame_id when set
+    bool depth = false;             ///< DepthImage
+    bool scan = false;              ///< LaserScan (neither: PointCloud2)
+    ScanRayOptions scan_options;    ///< LaserScan: +Inf and range_max readings
     bool zero_is_no_return = false;
     bool frustum = false;  ///< clearing_mode frustum (depth sources)
     int stride = 1;

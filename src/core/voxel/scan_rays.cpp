@@ -8,7 +8,7 @@
 namespace downstream_perception {
 
 void scanToRays(const LaserScanView& scan, const Eigen::Isometry3d& T_world_sensor,
-                bool inf_is_valid, bool range_max_is_no_return, DepthRays* out) {
+                const ScanRayOptions& options, DepthRays* out) {
   const std::string why = scan.validate();
   if (!why.empty()) throw std::invalid_argument("laser scan: " + why);
   if (!T_world_sensor.matrix().allFinite()) {
@@ -26,8 +26,11 @@ void scanToRays(const LaserScanView& scan, const Eigen::Isometry3d& T_world_sens
     const Eigen::Vector3d dir(std::cos(a), std::sin(a), 0.0);
     const double r = scan.ranges[k];
     const bool inf = r == std::numeric_limits<double>::infinity();
-    if ((inf && inf_is_valid) || (range_max_is_no_return && r == scan.range_max)) {
+    if ((inf && options.inf_is_no_return) ||
+        (options.range_max_is_no_return && r == scan.range_max)) {
       push(&out->no_returns, T_world_sensor * dir);
+    } else if (inf && options.inf_is_valid) {
+      push(&out->hits, T_world_sensor * (dir * (scan.range_max - 1e-4)));
     } else if (std::isfinite(r) && r >= scan.range_min && r <= scan.range_max) {
       push(&out->hits, T_world_sensor * (dir * r));
     } else {

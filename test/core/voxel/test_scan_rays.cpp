@@ -43,11 +43,17 @@ void expectPoint(const std::vector<float>& v, std::size_t i, double x, double y,
   EXPECT_NEAR(v[3 * i + 2], z, 1e-5);
 }
 
+ScanRayOptions noReturn() {
+  ScanRayOptions o;
+  o.inf_is_no_return = true;
+  return o;
+}
+
 }  // namespace
 
 TEST(ScanRays, Rep117HandWorked) {
   DepthRays out;
-  scanToRays(view(), pose(), true, false, &out);
+  scanToRays(view(), pose(), noReturn(), &out);
   // Beam 0 (sensor +x = world +y) returns at 1 m: (1, 3, 0.5). Beam 6 (270 deg = sensor -y =
   // world +x) at range_max 5 m is a return: (6, 2, 0.5).
   ASSERT_EQ(out.hits.size(), 6u);
@@ -59,9 +65,11 @@ TEST(ScanRays, Rep117HandWorked) {
   expectPoint(out.no_returns, 0, 1.0 - std::sqrt(0.5), 2.0 + std::sqrt(0.5), 0.5);
   // NaN, -Inf, 0.05 < range_min, 7 > range_max.
   EXPECT_EQ(out.invalid, 4u);
-  // Without inf_is_valid +Inf is skipped; with range_max_is_no_return beam 6 is a no-return
+  // Without inf_is_no_return +Inf is skipped; with range_max_is_no_return beam 6 is a no-return
   // 1 m along world +x: (2, 2, 0.5).
-  scanToRays(view(), pose(), false, true, &out);
+  ScanRayOptions range_max;
+  range_max.range_max_is_no_return = true;
+  scanToRays(view(), pose(), range_max, &out);
   EXPECT_EQ(out.hits.size(), 3u);
   ASSERT_EQ(out.no_returns.size(), 3u);
   expectPoint(out.no_returns, 0, 2.0, 2.0, 0.5);
@@ -78,7 +86,7 @@ TEST(ScanRays, UpsideDownScannerMirrorsTheFan) {
   s.count = 1;
   s.angle_min = M_PI / 2;
   DepthRays out;
-  scanToRays(s, T, true, false, &out);
+  scanToRays(s, T, noReturn(), &out);
   expectPoint(out.hits, 0, 0.0, -2.0, 0.0);
 }
 
@@ -96,7 +104,7 @@ TEST(ScanRays, IntoTheVoxelMapMarksAndClears) {
   s.ranges = r.data();
   s.count = 1;
   DepthRays out;
-  scanToRays(s, T, true, false, &out);
+  scanToRays(s, T, noReturn(), &out);
   VoxelRayConfig rays;
   map.integrate(T.translation(), out.hits.data(), out.hits.size() / 3, out.no_returns.data(),
                 out.no_returns.size() / 3, 0.0, rays);
@@ -109,8 +117,27 @@ TEST(ScanRays, InvalidScanRefused) {
   LaserScanView s = view();
   s.angle_increment = 0.0;
   DepthRays out;
-  EXPECT_THROW(scanToRays(s, pose(), true, false, &out), std::invalid_argument);
+  EXPECT_THROW(scanToRays(s, pose(), noReturn(), &out), std::invalid_argument);
   Eigen::Isometry3d T = pose();
   T.translation().x() = std::nan("");
-  EXPECT_THROW(scanToRays(view(), T, true, false, &out), std::invalid_argument);
+  EXPECT_THROW(scanToRays(view(), T, noReturn(), &out), std::invalid_argument);
+}
+
+TEST(ScanRays, InfIsValidKeepsCostmap2dMeaning) {
+  // costmap_2d substitutes range_max - 0.1 mm for +Inf: a return (it clears to there, and marks
+  // if within obstacle_range), not a no-return. Beam 1 at 45 degrees in the sensor frame is world
+  // (-0.7071, 0.7071) from (1, 2): 4.9999 m along it.
+  ScanRayOptions valid;
+  valid.inf_is_valid = true;
+  DepthRays out;
+  scanToRays(view(), pose(), valid, &out);
+  ASSERT_EQ(out.hits.size(), 9u);
+  EXPECT_TRUE(out.no_returns.empty());
+  const double r = 5.0 - 1e-4;
+  expectPoint(out.hits, 1, 1.0 - r * std::sqrt(0.5), 2.0 + r * std::sqrt(0.5), 0.5);
+  // Both set: ours (a no-return) wins, as in the obstacle layer.
+  valid.inf_is_no_return = true;
+  scanToRays(view(), pose(), valid, &out);
+  EXPECT_EQ(out.hits.size(), 6u);
+  EXPECT_EQ(out.no_returns.size(), 3u);
 }

@@ -4,7 +4,7 @@ unknown.
 
 The scanner sits 0.3 m above the odom origin looking along +x with beams from -90 to +90 degrees.
 A wall at x = 1.525 m answers the beams within 60 degrees of the axis; the others see nothing (+Inf,
-inf_is_valid: they clear to raytrace_range, 3 m).
+inf_is_no_return: they clear to raytrace_range, 3 m).
 """
 
 from __future__ import annotations
