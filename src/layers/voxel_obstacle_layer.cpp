@@ -1,14 +1,17 @@
 #include "downstream_perception/layers/voxel_obstacle_layer.h"
 
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <sensor_msgs/point_cloud_conversion.h>
 #include <pluginlib/class_list_macros.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <sstream>
 
+#include "downstream_perception/core/costmap/footprint.h"
 #include "downstream_perception/core/grid/cost_values.h"
 #include "downstream_perception/core/voxel/depth_rays.h"
 #include "downstream_perception/core/voxel/scan_rays.h"
@@ -69,11 +72,20 @@ void VoxelObstacleLayer::onInitialize() {
     c.resolution_m = resolution;
   }
   config_ = c;
+  // costmap_2d's layer-level keys read elsewhere: obstacle_range / raytrace_range are found from
+  // each source upward (searchParam, readSource); transform_tolerance is validated only (the
+  // MessageFilter waits for each message's own transform, as in costmap_2d in practice).
+  reader.known({"obstacle_range", "raytrace_range"});
+  double transform_tolerance = 0.2;
+  reader.get("transform_tolerance", &transform_tolerance);
+  if (!std::isfinite(transform_tolerance) || transform_tolerance < 0.0) {
+    config_errors_.add("transform_tolerance must be finite and >= 0 s, got " +
+                       std::to_string(transform_tolerance));
+  }
   std::string names;
   reader.get("observation_sources", &names);
-  reader.unsupported("footprint_clearing_enabled",
-                     "the footprint is not cleared in 3-D (a robot's own body seen by its camera "
-                     "should be filtered before the layer)");
+  // costmap_2d's key and default: the robot stands in its footprint, so nothing else is there.
+  reader.get("footprint_clearing_enabled", &footprint_clearing_enabled_);
   {
     std::istringstream stream(names);
     std::string name;
@@ -102,7 +114,8 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   auto s = std::make_unique<Source>();
   s->name = name;
   s->topic = name;
-  std::string data_type = "PointCloud2";
+  // costmap_2d's default data_type (sensor_msgs/PointCloud, converted as costmap_2d converts).
+  std::string data_type = "PointCloud";
   reader.get("topic", &s->topic);
   reader.get("data_type", &data_type);
   reader.get("sensor_frame", &s->sensor_frame);
@@ -125,10 +138,16 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   reader.get("clearing_mode", &clearing_mode);
   reader.get("stride", &s->stride);
   reader.get("tf_queue_size", &s->tf_queue_size);
-  reader.unsupported("min_obstacle_height",
-                     "the height band is the layer's min/max_obstacle_height: points outside it "
-                     "still mark voxels, which then do not reach the costmap");
-  reader.unsupported("max_obstacle_height", "see min_obstacle_height");
+  if (data_type == "DepthImage") {
+    reader.unsupported("min_obstacle_height",
+                       "depth images mark every pixel; the layer's min/max_obstacle_height decide "
+                       "which voxels reach the costmap");
+    reader.unsupported("max_obstacle_height", "see min_obstacle_height");
+  } else {
+    // costmap_2d's source band (its defaults 0 and 2 m): points outside it neither mark nor clear.
+    reader.get("min_obstacle_height", &s->min_z_m);
+    reader.get("max_obstacle_height", &s->max_z_m);
+  }
   reader.unsupported("observation_persistence", "each observation is integrated once");
   reader.unsupported("expected_update_rate", "not checked by this layer");
   if (data_type == "LaserScan") {
@@ -152,8 +171,13 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   reader.warnUnknown();
   for (const auto& w : reader.warnings()) param_warnings_.push_back("source '" + name + "': " + w);
   std::string why = s->rays.validate();
-  if (data_type != "PointCloud2" && data_type != "DepthImage" && data_type != "LaserScan") {
-    why = "data_type '" + data_type + "' is not supported (PointCloud2, DepthImage or LaserScan)";
+  if (data_type != "PointCloud" && data_type != "PointCloud2" && data_type != "DepthImage" &&
+      data_type != "LaserScan") {
+    why = "data_type '" + data_type +
+          "' is not supported (PointCloud, PointCloud2, DepthImage or LaserScan)";
+  } else if (!(s->min_z_m <= s->max_z_m) || std::isnan(s->min_z_m) || std::isnan(s->max_z_m)) {
+    why = "min_obstacle_height " + std::to_string(s->min_z_m) +
+          " m must be <= max_obstacle_height " + std::to_string(s->max_z_m) + " m";
   } else if (clearing_mode != "ray" && clearing_mode != "frustum") {
     why = "clearing_mode '" + clearing_mode + "' is not supported (ray or frustum)";
   } else if (clearing_mode == "frustum" && data_type != "DepthImage") {
@@ -172,6 +196,11 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   s->depth = data_type == "DepthImage";
   s->frustum = clearing_mode == "frustum";
   s->scan = data_type == "LaserScan";
+  s->legacy_cloud = data_type == "PointCloud";
+  if (s->depth) {
+    s->min_z_m = -std::numeric_limits<double>::infinity();
+    s->max_z_m = std::numeric_limits<double>::infinity();
+  }
   if (s->depth && s->camera_info_topic.empty()) {
     // image_transport's convention: the camera_info next to the image.
     const std::size_t slash = s->topic.rfind('/');
@@ -216,6 +245,14 @@ void VoxelObstacleLayer::activate() {
                        tf2_ros::filter_failure_reasons::FilterFailureReason r) {
             on_failure(m, r);
           });
+    } else if (s->legacy_cloud) {
+      s->legacy_cloud_sub.subscribe(
+          topic_nh_, s->topic, *tf_, frame, s->tf_queue_size,
+          [this, s](const sensor_msgs::PointCloudConstPtr& m) { onLegacyCloud(s, m); },
+          [on_failure](const sensor_msgs::PointCloudConstPtr& m,
+                       tf2_ros::filter_failure_reasons::FilterFailureReason r) {
+            on_failure(m, r);
+          });
     } else {
       s->cloud_sub.subscribe(
           topic_nh_, s->topic, *tf_, frame, s->tf_queue_size,
@@ -231,6 +268,7 @@ void VoxelObstacleLayer::activate() {
 void VoxelObstacleLayer::deactivate() {
   for (auto& s : sources_) {
     s->cloud_sub.unsubscribe();
+    s->legacy_cloud_sub.unsubscribe();
     s->depth_sub.unsubscribe();
     s->scan_sub.unsubscribe();
     s->info_sub.shutdown();
@@ -343,11 +381,32 @@ void VoxelObstacleLayer::onScan(Source* s, const sensor_msgs::LaserScanConstPtr&
   integrate(s, pose.translation(), rays.hits, rays.no_returns, msg->header.stamp);
 }
 
+void VoxelObstacleLayer::onLegacyCloud(Source* s, const sensor_msgs::PointCloudConstPtr& msg) {
+  // costmap_2d converts too; the converted cloud then meets the same checks as a PointCloud2.
+  sensor_msgs::PointCloud2 cloud;
+  if (!sensor_msgs::convertPointCloudToPointCloud2(*msg, cloud)) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++s->received;
+    }
+    reject(s,
+           "PointCloud conversion failed (a channel's value count differs from the point "
+           "count?)");
+    return;
+  }
+  onCloudMessage(s, cloud);
+}
+
 void VoxelObstacleLayer::onCloud(Source* s, const sensor_msgs::PointCloud2ConstPtr& msg) {
+  onCloudMessage(s, *msg);
+}
+
+void VoxelObstacleLayer::onCloudMessage(Source* s, const sensor_msgs::PointCloud2& cloud) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++s->received;
   }
+  const sensor_msgs::PointCloud2* msg = &cloud;
   std::size_t x_offset = 0;
   const std::string why = checkCloudLayout(*msg, &x_offset);
   if (!why.empty()) {
@@ -371,8 +430,13 @@ void VoxelObstacleLayer::onCloud(Source* s, const sensor_msgs::PointCloud2ConstP
 }
 
 void VoxelObstacleLayer::integrate(Source* s, const Eigen::Vector3d& origin,
-                                   const std::vector<float>& hits,
-                                   const std::vector<float>& no_returns, const ros::Time& stamp) {
+                                   std::vector<float>& hits, const std::vector<float>& no_returns,
+                                   const ros::Time& stamp) {
+  const std::size_t outside = dropOutsideHeightBand(&hits, s->min_z_m, s->max_z_m);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s->outside_band += outside;
+  }
   runIntegration(s, stamp, [&] {
     return map_->integrate(origin, hits.data(), hits.size() / 3, no_returns.data(),
                            no_returns.size() / 3, stamp.toSec(), s->rays);
@@ -450,15 +514,41 @@ void VoxelObstacleLayer::reset() {
 void VoxelObstacleLayer::onClockJump() {
   for (auto& s : sources_) {
     s->cloud_sub.clearWaiting();
+    s->legacy_cloud_sub.clearWaiting();
     s->depth_sub.clearWaiting();
+    s->scan_sub.clearWaiting();
   }
 }
 
-void VoxelObstacleLayer::updateBounds(double, double, double, double* min_x, double* min_y,
-                                      double* max_x, double* max_y) {
+void VoxelObstacleLayer::clearFootprint(double robot_x, double robot_y, double robot_yaw,
+                                        const ros::Time& now) {
+  // costmap_2d frees the footprint's cells in its 2-D layer; here the band voxels of those
+  // columns become free, so the cells stay free until something is seen there again, as there.
+  // Caller holds mutex_.
+  const GridGeometry& g = layered_costmap_->costmap().geometry();
+  const Footprint world =
+      transformFootprint(layered_costmap_->footprint(), Pose2D{robot_x, robot_y, robot_yaw});
+  footprint_cells_.clear();
+  polygonCells(world, g, &footprint_cells_);
+  footprint_columns_.clear();
+  for (const std::size_t i : footprint_cells_) {
+    const CellIndex c = g.cellOf(i);
+    footprint_columns_.emplace_back(c.x, c.y);
+  }
+  const VoxelIntegrationStats stats = map_->clearColumns(footprint_columns_, now.toSec());
+  footprint_voxels_cleared_ += stats.cleared;
+  dropped_updates_ += stats.dropped_updates;
+  dirty_.expand(stats.touched);
+}
+
+void VoxelObstacleLayer::updateBounds(double robot_x, double robot_y, double robot_yaw,
+                                      double* min_x, double* min_y, double* max_x, double* max_y) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!map_ || !enabled_) return;
   const ros::Time now = ros::Time::now();
+  if (footprint_clearing_enabled_ && layered_costmap_->hasRobotPose()) {
+    clearFootprint(robot_x, robot_y, robot_yaw, now);
+  }
   if (config_.decay_time_s > 0.0) {
     redraw_all_ = true;  // every column may change with time
     if (last_prune_.isZero() || (now - last_prune_).toSec() >= prune_period_s_) {
@@ -540,12 +630,15 @@ void VoxelObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
   }
   status.add("updates dropped by the memory bound", dropped_updates_);
   status.add("lethal columns (last update)", lethal_columns_);
+  status.add("footprint clearing", footprint_clearing_enabled_);
+  status.add("voxels cleared under the footprint", footprint_voxels_cleared_);
   std::string stale;
   for (const auto& s : sources_) {
     const std::string p = "source '" + s->name + "' ";
     status.add(p + "received", s->received);
     status.add(p + "integrated", s->integrated);
     status.add(p + "refused", s->rejected);
+    status.add(p + "points outside height band", s->outside_band);
     if (!s->last_rejection.empty()) status.add(p + "last refusal", s->last_rejection);
     status.add(p + "last rays", s->last.rays);
     status.add(p + "last voxels marked", s->last.marked);

@@ -315,22 +315,16 @@ void bindStaticMap(py::module& m) {
                      "costmap_2d's StaticLayer default (layer level)")
       .def_readwrite("use_maximum", &StaticMapConfig::use_maximum,
                      "combine with the master by max instead of overwriting")
-      .def_readwrite(
-          "lethal_cost_threshold", &StaticMapConfig::lethal_cost_threshold,
-          "occupancy value (0..100) from which a cell is lethal (occupancy value (0..100) from "
-          "which a cell is lethal (occupancy value 0..100 (clamped) from which a cell is lethal))")
-      .def_readwrite(
-          "unknown_cost_value", &StaticMapConfig::unknown_cost_value,
-          "occupancy value meaning unknown (compared as a byte) (occupancy value meaning unknown "
-          "(compared as a byte) (occupancy value meaning unknown, compared as a byte (-1 = 255)))")
+      .def_readwrite("lethal_cost_threshold", &StaticMapConfig::lethal_cost_threshold,
+                     "occupancy value (0..100) from which a cell is lethal")
+      .def_readwrite("unknown_cost_value", &StaticMapConfig::unknown_cost_value,
+                     "occupancy value meaning unknown (compared as a byte)")
       .def_readwrite("trinary_costmap", &StaticMapConfig::trinary_costmap,
                      "false: below-lethal values scale to 0..253")
       .def_readwrite(
           "max_cells", &StaticMapConfig::max_cells,
           "Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one "
-          "byte per cell here, one in the master, one in each published grid). (Largest map "
-          "accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell "
-          "here, one in the master, one in each published grid). (largest map accepted, cells))");
+          "byte per cell here, one in the master, one in each published grid).");
   m.def(
       "static_map_values",
       [](py::array_t<std::int8_t, py::array::c_style | py::array::forcecast> occupancy,

@@ -63,12 +63,9 @@ void bindEsdf(py::module& m) {
       m, "EsdfConfig",
       "Parameters of the Euclidean signed distance field computed from the TSDF (metres).")
       .def(py::init<>())
-      .def_readwrite(
-          "max_distance_m", &EsdfConfig::max_distance_m,
-          "Distances are clamped at this (m). Also the reach of a change: a voxel that changes "
-          "state alters distances within this radius only. (Distances are clamped at this (m). "
-          "Also the reach of a change: a voxel that changes state alters distances within this "
-          "radius only. (distances are clamped at this (m); also a change's reach))")
+      .def_readwrite("max_distance_m", &EsdfConfig::max_distance_m,
+                     "Distances are clamped at this (m). Also the reach of a change: a voxel that "
+                     "changes state alters distances within this radius only.")
       .def("validate", &EsdfConfig::validate, py::arg("voxel_size_m"),
            "Empty string if valid for TSDF voxels of voxel_size_m (m), else the reason.");
   py::class_<EsdfUpdateStats>(

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/voxel/depth_rays.h"
@@ -80,37 +81,26 @@ void bindVoxel(py::module& m) {
   py::class_<VoxelMapConfig>(m, "VoxelMapConfig",
                              "3-D voxel obstacle map settings (costmap_2d VoxelLayer's meaning).")
       .def(py::init<>())
-      .def_readwrite("resolution_m", &VoxelMapConfig::resolution_m,
-                     "Edge of a voxel in x and y, m (the layer uses the costmap's resolution). "
-                     "Default 0.05. (Edge of a voxel in x and y, m (the layer uses the costmap's "
-                     "resolution). Default 0.05. (voxel edge in x, y (m)))")
       .def_readwrite(
-          "z_resolution_m", &VoxelMapConfig::z_resolution_m,
-          "Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (Height of a "
-          "voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (voxel height (m)))")
+          "resolution_m", &VoxelMapConfig::resolution_m,
+          "Edge of a voxel in x and y, m (the layer uses the costmap's resolution). Default 0.05.")
+      .def_readwrite("z_resolution_m", &VoxelMapConfig::z_resolution_m,
+                     "Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2.")
       .def_readwrite("origin_z_m", &VoxelMapConfig::origin_z_m,
-                     "Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0. "
-                     "(Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default "
-                     "0. (bottom of voxel layer 0 (m)))")
+                     "Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0.")
       .def_readwrite("z_voxels", &VoxelMapConfig::z_voxels,
                      "Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most "
-                     "kMaxZVoxels). Default 10. (Voxels per column (costmap_2d `z_voxels`, there "
-                     "at most 16; here at most kMaxZVoxels). Default 10. (voxels per column))")
+                     "kMaxZVoxels). Default 10.")
       .def_readwrite("mark_threshold", &VoxelMapConfig::mark_threshold,
                      "A column with MORE than this many occupied voxels in the height band is "
-                     "lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. "
-                     "(A column with MORE than this many occupied voxels in the height band is "
-                     "lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. "
-                     "(a column with more occupied band voxels than this is lethal))")
+                     "lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks.")
       .def_readwrite(
           "unknown_threshold", &VoxelMapConfig::unknown_threshold,
-          "A column with AT MOST this many unknown voxels in the band is known; a known column "
-          "that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). "
-          "Default 15 (with 10 voxels: every column counts as known, as in costmap_2d). (A column "
-          "with AT MOST this many unknown voxels in the band is known; a known column that is not "
-          "lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with "
-          "10 voxels: every column counts as known, as in costmap_2d). (a column with at most this "
-          "many unknown band voxels is known))")
+          "A column with AT MOST this many unknown voxels is known; a known column that is not "
+          "lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Counted as "
+          "costmap_2d counts: the band's unknown voxels plus 16 - band when the band has fewer "
+          "than 16 voxels (costmap_2d's 16-bit column). Default 15: with 10 voxels, a column is "
+          "free once one of its voxels is known, and unknown until then.")
       .def_readwrite("min_obstacle_height_m", &VoxelMapConfig::min_obstacle_height_m,
                      "The robot's height band, m: only voxels whose centre lies in [min, max] are "
                      "projected into the 2-D costmap (an overhang above the robot is kept in 3-D "
@@ -140,20 +130,13 @@ void bindVoxel(py::module& m) {
                      "a no-return ray clears this far, m")
       .def_readwrite("marking", &VoxelRayConfig::marking, "returns mark their voxel")
       .def_readwrite("clearing", &VoxelRayConfig::clearing, "rays clear the voxels they cross")
-      .def_readwrite(
-          "one_ray_per_end_voxel", &VoxelRayConfig::one_ray_per_end_voxel,
-          "Of the rays of a frame that end in the same voxel, cast only the first (every return "
-          "still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped "
-          "ray (beside the cast one, near the end, where rays to one voxel diverge by less than a "
-          "voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth "
-          "image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, "
-          "costmap_2d's behaviour). (Of the rays of a frame that end in the same voxel, cast only "
-          "the first (every return still marks). Each cast ray is still walked exactly; a voxel "
-          "crossed only by a skipped ray (beside the cast one, near the end, where rays to one "
-          "voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far "
-          "fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false "
-          "(every ray exact, costmap_2d's behaviour). (cast only the first ray of a frame ending "
-          "in each voxel))")
+      .def_readwrite("one_ray_per_end_voxel", &VoxelRayConfig::one_ray_per_end_voxel,
+                     "Of the rays of a frame that end in the same voxel, cast only the first "
+                     "(every return still marks). Each cast ray is still walked exactly; a voxel "
+                     "crossed only by a skipped ray (beside the cast one, near the end, where rays "
+                     "to one voxel diverge by less than a voxel) is not cleared in that frame. "
+                     "Trades that for far fewer rays: a 640x480 depth image has ~40 pixels per 5 "
+                     "cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour).")
       .def("validate", &VoxelRayConfig::validate, "Empty string if valid, else the reason.");
 
   py::class_<VoxelMap>(m, "VoxelMap", "Sparse 3-D log-odds voxels over a rolling window.")
@@ -294,6 +277,34 @@ void bindVoxel(py::module& m) {
       .def("prune", &VoxelMap::prune, py::arg("now_s"),
            "Frees the blocks in which no voxel is known any more at now_s (decay); returns the "
            "blocks freed.")
+      .def(
+          "clear_columns",
+          [](VoxelMap& self,
+             const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& columns,
+             double stamp_s) {
+            if (columns.ndim() != 2 || (columns.shape(1) != 2 && columns.shape(0) != 0)) {
+              throw std::invalid_argument("columns must be (N, 2) window column indices (x, y)");
+            }
+            std::vector<std::pair<int, int>> cols;
+            const auto a = columns.unchecked<2>();
+            constexpr std::int64_t kLimit = std::int64_t{1} << 30;
+            for (py::ssize_t i = 0; i < columns.shape(0); ++i) {
+              // Far outside any window (and any int): skipped, as clearColumns skips outsiders.
+              const auto far = [](std::int64_t v) { return v < -kLimit || v > kLimit; };
+              if (far(a(i, 0)) || far(a(i, 1))) continue;
+              cols.emplace_back(static_cast<int>(a(i, 0)), static_cast<int>(a(i, 1)));
+            }
+            VoxelIntegrationStats s;
+            {
+              py::gil_scoped_release release;
+              s = self.clearColumns(cols, stamp_s);
+            }
+            return statsToDict(s);
+          },
+          py::arg("columns"), py::arg("stamp_s"),
+          "costmap_2d's footprint clearing in 3-D: every band voxel of the given window columns "
+          "(N x 2: x, y) becomes free; columns outside the window are skipped. Returns the "
+          "counts.")
       .def("clear", &VoxelMap::clear, "Forgets everything (all voxels unknown).");
 
   m.def(

@@ -1853,7 +1853,7 @@ def gen_voxel_map(rng: np.random.Generator) -> dict[str, Any]:
     g = Gen(rng, 0.2)
     ops: list[tuple[Any, ...]] = []
     for _ in range(int(rng.integers(1, 7))):
-        op = g.pick(("points", "points", "depth", "window", "prune", "clear"))
+        op = g.pick(("points", "points", "depth", "window", "columns", "prune", "clear"))
         if op == "points":
             n, m = int(g.pick((0, 1, 40))), int(g.pick((0, 1, 10)))
             ops.append(
@@ -1873,6 +1873,12 @@ def gen_voxel_map(rng: np.random.Generator) -> dict[str, Any]:
                 + (voxel_ray_config_args(g), g.b(), g.i(1, 3, 0.1, INT32_NASTY))
                 + (g.pick(("ray", "frustum", "frustum", "")),)
             )
+        elif op == "columns":
+            n = int(g.pick((0, 1, 30)))
+            columns = rng.integers(-5, 125, size=(n, 2))
+            if g.chance(0.1):
+                columns = np.array([[2**62, -(2**62)], [2**31, 0]] * (n // 2 + 1))
+            ops.append((op, columns if g.chance(0.9) else g.array((n, 3), -5, 125), g.f(0, 10, 0.1)))
         elif op == "window":
             ops.append(
                 (op, *(g.i(-50, 50, 0.1, INT32_NASTY) for _ in range(2)))
@@ -1919,6 +1925,10 @@ def call_voxel_map(a: dict[str, Any]) -> Any:
                 )
                 if s["marked"] + s["cleared"] > s["voxels_walked"] + s["rays"]:
                     problems.append(f"more updates than visits: {s}")
+            elif op[0] == "columns":
+                s = vmap.clear_columns(op[1], op[2])
+                if s["marked"] or s["cleared"] > len(op[1]) * vmap.shape[2]:
+                    problems.append(f"clear_columns: {s} for {len(op[1])} columns")
             elif op[0] == "window":
                 vmap.set_window(*op[1:])
                 moved = True

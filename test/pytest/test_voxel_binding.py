@@ -146,3 +146,36 @@ def test_unknown_clearing_mode_is_refused() -> None:
     depth = np.ones((cam.height, cam.width), dtype=np.float32)
     with pytest.raises(ValueError, match="clearing_mode"):
         vmap.integrate_depth(depth, pinhole, np.eye(4), 0.0, rays(), False, 1, "cone")
+
+
+def test_costmap2d_defaults_keep_untouched_columns_unknown() -> None:
+    # costmap_2d VoxelLayer's defaults (10 voxels of 0.2 m, unknown_threshold 15): its 16-bit
+    # column counts 6 bits that never become known, so an untouched column is unknown (16 > 15)
+    # and one known voxel makes it free.
+    c = dp.VoxelMapConfig()
+    c.resolution_m = 0.1
+    vmap = dp.VoxelMap(c, 0.0, 0.0, 20, 20)
+    assert (vmap.project(0.0) == UNKNOWN).all()
+    # A horizontal ray at 0.1 m along row y 5 from x 0.05 to a return at x 1.05.
+    vmap.integrate([0.05, 0.55, 0.1], np.array([[1.05, 0.55, 0.1]]), np.zeros((0, 3)), 0.0, rays())
+    costs = vmap.project(0.0)
+    assert costs[5, :10].tolist() == [FREE] * 10
+    assert costs[5, 10] == LETHAL
+    assert vmap.column(5, 5, 0.0) == (0, 9, FREE)
+    assert (np.delete(costs, 5, axis=0) == UNKNOWN).all()
+
+
+def test_clear_columns_frees_the_band_under_a_footprint() -> None:
+    vmap = dp.VoxelMap(room_config(), 0.0, 0.0, 40, 40)
+    # Two obstacles in the band at columns (10, 10) and (12, 10), one above the band.
+    hits = np.array([[0.525, 0.525, 0.5], [0.625, 0.525, 0.5], [0.525, 0.525, 1.95]])
+    vmap.integrate([0.525, 0.525, 1.0], hits, np.zeros((0, 3)), 0.0, rays())
+    assert vmap.project(0.0)[10, 10] == LETHAL and vmap.project(0.0)[10, 12] == LETHAL
+    stats = vmap.clear_columns(np.array([[10, 10], [-5, 3], [10**12, 0]]), 1.0)
+    assert stats["cleared"] == 36  # band voxels 2..37 of column (10, 10)
+    costs = vmap.project(1.0)
+    assert costs[10, 10] == FREE and costs[10, 12] == LETHAL
+    assert vmap.state(10, 10, 39, 1.0) == 1  # above the band: kept
+    assert vmap.clear_columns(np.array([[10, 10]]), 2.0)["cleared"] == 0
+    with pytest.raises(ValueError):
+        vmap.clear_columns(np.zeros((3, 3), dtype=np.int64), 0.0)

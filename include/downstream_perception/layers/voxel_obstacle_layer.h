@@ -12,6 +12,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <functional>
@@ -19,6 +20,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/running_stats.h"
@@ -56,14 +58,20 @@ class VoxelObstacleLayer : public Layer {
     std::string camera_info_topic;  ///< depth sources
     std::string sensor_frame;       ///< overrides the message's frame_id when set
     bool depth = false;             ///< DepthImage
-    bool scan = false;              ///< LaserScan (neither: PointCloud2)
-    ScanRayOptions scan_options;    ///< LaserScan: +Inf and range_max readings
+    bool scan = false;              ///< LaserScan
+    bool legacy_cloud = false;      ///< sensor_msgs/PointCloud (none of these: PointCloud2)
+    /// costmap_2d's source band in the global frame, m (its defaults 0 and 2; DepthImage: none):
+    /// points outside it neither mark nor clear.
+    double min_z_m = 0.0;
+    double max_z_m = 2.0;
+    ScanRayOptions scan_options;  ///< LaserScan: +Inf and range_max readings
     bool zero_is_no_return = false;
     bool frustum = false;  ///< clearing_mode frustum (depth sources)
     int stride = 1;
     int tf_queue_size = 20;
     VoxelRayConfig rays;
     FilteredSubscription<sensor_msgs::PointCloud2> cloud_sub;
+    FilteredSubscription<sensor_msgs::PointCloud> legacy_cloud_sub;
     FilteredSubscription<sensor_msgs::Image> depth_sub;
     FilteredSubscription<sensor_msgs::LaserScan> scan_sub;
     ros::Subscriber info_sub;
@@ -72,6 +80,7 @@ class VoxelObstacleLayer : public Layer {
     std::size_t received = 0;
     std::size_t integrated = 0;
     std::size_t rejected = 0;
+    std::size_t outside_band = 0;  ///< points dropped by the source's height band
     std::string last_rejection;
     VoxelIntegrationStats last;
     TimingStats integrate_ms;
@@ -79,14 +88,18 @@ class VoxelObstacleLayer : public Layer {
 
   void readSource(const std::string& name);
   void onCloud(Source* s, const sensor_msgs::PointCloud2ConstPtr& msg);
+  void onLegacyCloud(Source* s, const sensor_msgs::PointCloudConstPtr& msg);
+  void onCloudMessage(Source* s, const sensor_msgs::PointCloud2& msg);
   void onDepth(Source* s, const sensor_msgs::ImageConstPtr& msg);
   void onScan(Source* s, const sensor_msgs::LaserScanConstPtr& msg);
   void onCameraInfo(Source* s, const sensor_msgs::CameraInfoConstPtr& msg);
   void reject(Source* s, const std::string& why);
   /// sensor -> global at the stamp; false (and a rejection) when tf cannot give it.
   bool lookup(Source* s, const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
-  void integrate(Source* s, const Eigen::Vector3d& origin, const std::vector<float>& hits,
+  /// Drops the hits outside the source's height band, then integrates (hits is modified).
+  void integrate(Source* s, const Eigen::Vector3d& origin, std::vector<float>& hits,
                  const std::vector<float>& no_returns, const ros::Time& stamp);
+  void clearFootprint(double robot_x, double robot_y, double robot_yaw, const ros::Time& now);
   void integrateFrustum(Source* s, const std::vector<float>& metres, const PinholeCamera& camera,
                         const Eigen::Isometry3d& pose, const ros::Time& stamp);
   /// Runs one integration under the lock and books its result (timing, counts, dirty window).
@@ -101,6 +114,10 @@ class VoxelObstacleLayer : public Layer {
   bool track_unknown_space_ = true;
   int combination_method_ = 1;  ///< 0 overwrite, 1 maximum (costmap_2d's default)
   bool publish_voxel_map_ = false;
+  bool footprint_clearing_enabled_ = true;  ///< costmap_2d's default
+  std::vector<std::size_t> footprint_cells_;
+  std::vector<std::pair<int, int>> footprint_columns_;
+  std::size_t footprint_voxels_cleared_ = 0;
   bool redraw_all_ = true;  ///< the whole window changed (resize, shift, decay, reset)
   CellBounds dirty_;        ///< window-relative columns changed since the last update
   double prune_period_s_ = 1.0;

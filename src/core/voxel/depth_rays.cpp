@@ -1,5 +1,6 @@
 #include "downstream_perception/core/voxel/depth_rays.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -44,6 +45,19 @@ void depthToRays(const float* depth_m, const PinholeCamera& camera,
       }
     }
   }
+}
+
+std::size_t dropOutsideHeightBand(std::vector<float>* xyz, double min_z_m, double max_z_m) {
+  std::size_t kept = 0;
+  const std::size_t n = xyz->size() / 3;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float z = (*xyz)[3 * i + 2];
+    if (std::isfinite(z) && (z < min_z_m || z > max_z_m)) continue;
+    if (kept != i) std::copy_n(xyz->begin() + 3 * i, 3, xyz->begin() + 3 * kept);
+    ++kept;
+  }
+  xyz->resize(3 * kept);
+  return n - kept;
 }
 
 }  // namespace downstream_perception

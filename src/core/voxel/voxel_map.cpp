@@ -408,6 +408,30 @@ VoxelIntegrationStats VoxelMap::integrate(const Eigen::Vector3d& origin, const f
   return stats;
 }
 
+VoxelIntegrationStats VoxelMap::clearColumns(const std::vector<std::pair<int, int>>& columns,
+                                             double stamp_s) {
+  if (!std::isfinite(stamp_s)) throw std::invalid_argument("voxel map: stamp is not finite");
+  VoxelIntegrationStats stats;
+  if (columns.empty()) return stats;
+  const float stamp = beginFrame(stamp_s);
+  const auto floor = static_cast<float>(config_.log_odds.clamp_min);
+  // Any delta this negative clamps to the minimum in updateVoxel().
+  const auto to_floor =
+      static_cast<float>(config_.log_odds.clamp_min - config_.log_odds.clamp_max - 1.0);
+  for (const auto& [x, y] : columns) {
+    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+    for (int z = band_first_; z <= band_last_; ++z) {
+      const VoxelBlock* b = blockAt(x, y, z);
+      if (b != nullptr && config_.decay_time_s <= 0.0 &&
+          b->log_odds[voxelIndex(x + x0_, y + y0_, z)] <= floor) {
+        continue;
+      }
+      update(x, y, z, to_floor, stamp, &stats);
+    }
+  }
+  return stats;
+}
+
 double VoxelMap::logOdds(int x, int y, int z, double now_s) const {
   if (x < 0 || y < 0 || z < 0 || x >= nx_ || y >= ny_ || z >= config_.z_voxels) return 0.0;
   const VoxelBlock* b = blockAt(x, y, z);
@@ -432,9 +456,18 @@ VoxelColumn VoxelMap::column(int x, int y, double now_s) const {
   return c;
 }
 
+int VoxelMap::unknownCount(const VoxelColumn& c) const {
+  // costmap_2d keeps 16 bits per column whatever z_voxels is, and the bits above the column are
+  // never known: it compares unknown_threshold with 16 minus the known voxels. So with its
+  // defaults (10 voxels, threshold 15) a column no ray has touched stays unknown and one known
+  // voxel makes it free. A band of more than 16 voxels (ours) counts its own unknown voxels.
+  const int band = band_last_ - band_first_ + 1;
+  return c.unknown + std::max(0, kCostmap2dColumnBits - band);
+}
+
 std::uint8_t VoxelMap::columnCost(const VoxelColumn& c) const {
   if (c.occupied > config_.mark_threshold) return cost::kLethalObstacle;
-  if (c.unknown <= config_.unknown_threshold) return cost::kFreeSpace;
+  if (unknownCount(c) <= config_.unknown_threshold) return cost::kFreeSpace;
   return cost::kNoInformation;
 }
 

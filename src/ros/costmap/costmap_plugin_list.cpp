@@ -11,12 +11,12 @@ namespace downstream_perception {
 namespace {
 
 const std::map<std::string, std::string>& costmap2dTypes() {
-  // costmap_2d::VoxelLayer: a flattened voxel column until the 3-D voxel layer lands (the
-  // FlatVoxelLayer names each difference when it starts).
+  // costmap_2d::VoxelLayer: the 3-D voxel layer (its keys, sources and column rule); the 2-D
+  // FlatVoxelLayer stays loadable by its own name.
   static const std::map<std::string, std::string> types{
       {"costmap_2d::StaticLayer", "downstream_perception/StaticLayer"},
       {"costmap_2d::ObstacleLayer", "downstream_perception/LogOddsObstacleLayer"},
-      {"costmap_2d::VoxelLayer", "downstream_perception/FlatVoxelLayer"},
+      {"costmap_2d::VoxelLayer", "downstream_perception/VoxelObstacleLayer"},
       {"costmap_2d::InflationLayer", "downstream_perception/InflationLayer"},
   };
   return types;

@@ -10,6 +10,7 @@
 #include "downstream_perception/core/voxel/voxel_map.h"
 
 using namespace downstream_perception;  // NOLINT
+using cost::kFreeSpace;
 using cost::kLethalObstacle;
 using cost::kNoInformation;
 
@@ -143,6 +144,46 @@ TEST(VoxelMap, ColumnRuleFollowsCostmap2d) {
   // unknown): occupied 2 > 1.
   EXPECT_EQ(map.column(3, 3, 1.0).occupied, 2);
   EXPECT_EQ(costAt(map, 3, 3, 1.0), kLethalObstacle);
+}
+
+TEST(VoxelMap, UnknownCountIncludesCostmap2dsUnreachableBits) {
+  // costmap_2d VoxelLayer's defaults: 10 voxels of 0.2 m, unknown_threshold 15. Its column word
+  // has 16 bits; the 6 above z_voxels never become known, so an untouched column counts 16
+  // unknown (> 15: NO_INFORMATION) and one known voxel makes it free (15).
+  VoxelMapConfig c;
+  c.resolution_m = 0.1;
+  VoxelMap map(c, 0.0, 0.0, 20, 20);
+  EXPECT_EQ(map.bandFirst(), 0);
+  EXPECT_EQ(map.bandLast(), 9);
+  EXPECT_EQ(map.unknownCount(VoxelColumn{0, 10}), 16);
+  EXPECT_EQ(map.unknownCount(VoxelColumn{0, 9}), 15);
+  EXPECT_EQ(costAt(map, 5, 5, 0.0), kNoInformation);
+  std::vector<std::uint8_t> project;
+  map.project(0.0, &project);
+  EXPECT_EQ(project[5 * 20 + 5], kNoInformation);
+  // A ray at z 0.1 m (voxel 0) from x 0.05 to a return at x 1.05: voxels x 0..9 of row y 5 are
+  // crossed (0 .. 9 free), x 10 marked.
+  std::vector<float> pts;
+  add(&pts, 1.05, 0.55, 0.1);
+  integrate(&map, Eigen::Vector3d(0.05, 0.55, 0.1), pts, 0.0);
+  EXPECT_EQ(map.column(5, 5, 0.0).unknown, 9);
+  EXPECT_EQ(costAt(map, 5, 5, 0.0), kFreeSpace);
+  EXPECT_EQ(costAt(map, 10, 5, 0.0), kLethalObstacle);
+  EXPECT_EQ(costAt(map, 5, 6, 0.0), kNoInformation);  // the row beside: untouched
+  // TurtleBot 2's move_base config: 2 voxels, threshold 15: 14 bits never known, so one known
+  // voxel of two makes the column free (14 + 1 = 15), none leaves it unknown (16).
+  c.z_voxels = 2;
+  c.max_obstacle_height_m = 0.6;
+  VoxelMap low(c, 0.0, 0.0, 20, 20);
+  EXPECT_EQ(low.unknownCount(VoxelColumn{0, 2}), 16);
+  EXPECT_EQ(low.unknownCount(VoxelColumn{0, 1}), 15);
+  // A band of more than 16 voxels (ours) counts its own unknown voxels only.
+  c.z_voxels = 40;
+  c.z_resolution_m = 0.05;
+  c.max_obstacle_height_m = 2.0;
+  VoxelMap tall(c, 0.0, 0.0, 20, 20);
+  EXPECT_EQ(tall.bandLast() - tall.bandFirst() + 1, 40);
+  EXPECT_EQ(tall.unknownCount(VoxelColumn{0, 40}), 40);
 }
 
 TEST(VoxelMap, TableTopStaysWhileTheFloorUnderItIsSeen) {
@@ -404,4 +445,43 @@ TEST(DepthRays, BackProjectionHandWorked) {
   EXPECT_EQ(out.invalid, 1u);
   cam.fx = std::nan("");
   EXPECT_THROW(depthToRays(depth, cam, pose, false, 1, &out), std::invalid_argument);
+}
+
+TEST(VoxelMap, ClearColumnsFreesTheBandOnly) {
+  // roomConfig: band voxels 1..18 of 20. A column with a hit at voxel 5 and one at voxel 19
+  // (above the band): clearing it frees voxels 1..18 (the hit included) and keeps voxel 19.
+  VoxelMap map(roomConfig(), 0.0, 0.0, 40, 40);
+  std::vector<float> pts;
+  add(&pts, 0.35, 0.35, 0.55);
+  add(&pts, 0.35, 0.35, 1.95);
+  integrate(&map, Eigen::Vector3d(0.35, 0.35, 1.0), pts, 0.0);
+  ASSERT_EQ(map.state(3, 3, 5, 0.0), VoxelState::kOccupied);
+  ASSERT_EQ(costAt(map, 3, 3, 0.0), kLethalObstacle);
+  const auto s = map.clearColumns({{3, 3}, {-1, 3}, {40, 0}}, 1.0);
+  EXPECT_EQ(s.cleared, 18u);  // voxels 1..18; the columns outside the window are skipped
+  for (int z = 1; z <= 18; ++z) EXPECT_EQ(map.state(3, 3, z, 1.0), VoxelState::kFree) << z;
+  EXPECT_EQ(map.state(3, 3, 19, 1.0), VoxelState::kOccupied);
+  EXPECT_EQ(costAt(map, 3, 3, 1.0), kFreeSpace);
+  EXPECT_EQ(s.touched.min_x, 3);
+  EXPECT_EQ(s.touched.max_y, 3);
+  // Already at the floor and nothing decays: no rewrite, nothing touched.
+  const auto again = map.clearColumns({{3, 3}}, 2.0);
+  EXPECT_EQ(again.cleared, 0u);
+  EXPECT_TRUE(again.touched.empty());
+  EXPECT_THROW(map.clearColumns({{3, 3}}, std::nan("")), std::invalid_argument);
+}
+
+TEST(VoxelMap, HeightBandDropsPointsOutsideItOnly) {
+  // costmap_2d's source band [0.25, 0.35] m: below, above and inside; NaN kept for the count.
+  std::vector<float> pts;
+  add(&pts, 1.0, 0.0, 0.10);
+  add(&pts, 2.0, 0.0, 0.30);
+  add(&pts, 3.0, 0.0, 0.50);
+  add(&pts, 4.0, 0.0, std::nan(""));
+  add(&pts, 5.0, 0.0, 0.25);  // on the edge: kept, as costmap_2d keeps z == min
+  EXPECT_EQ(dropOutsideHeightBand(&pts, 0.25, 0.35), 2u);
+  ASSERT_EQ(pts.size(), 9u);
+  EXPECT_FLOAT_EQ(pts[0], 2.0f);
+  EXPECT_TRUE(std::isnan(pts[5]));
+  EXPECT_FLOAT_EQ(pts[6], 5.0f);
 }

@@ -22,7 +22,7 @@ TEST(OurLayerType, Costmap2dNamesMapToOurLayersAndSayHow) {
   EXPECT_NE(note.find("costmap_2d type 'costmap_2d::StaticLayer'"), std::string::npos) << note;
   EXPECT_EQ(ourLayerType("costmap_2d::ObstacleLayer"),
             "downstream_perception/LogOddsObstacleLayer");
-  EXPECT_EQ(ourLayerType("costmap_2d::VoxelLayer"), "downstream_perception/FlatVoxelLayer");
+  EXPECT_EQ(ourLayerType("costmap_2d::VoxelLayer"), "downstream_perception/VoxelObstacleLayer");
   EXPECT_EQ(ourLayerType("costmap_2d::InflationLayer"), "downstream_perception/InflationLayer");
 }
 

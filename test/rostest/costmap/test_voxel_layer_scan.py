@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """rostest: a LaserScan source of the VoxelObstacleLayer marks, clears and leaves unseen space
-unknown.
+unknown; a sensor_msgs/PointCloud source (costmap_2d's default data_type) marks within its own
+height band only, and the robot's footprint is cleared (costmap_2d's footprint_clearing_enabled).
 
 The scanner sits 0.3 m above the odom origin looking along +x with beams from -90 to +90 degrees.
 A wall at x = 1.525 m answers the beams within 60 degrees of the axis; the others see nothing (+Inf,
@@ -15,7 +16,8 @@ import unittest
 import numpy as np
 import rospy
 import rostest
-from sensor_msgs.msg import LaserScan
+from geometry_msgs.msg import Point32
+from sensor_msgs.msg import LaserScan, PointCloud
 from tf2_ros import StaticTransformBroadcaster
 
 from downstream_perception.ros.costmap_client import CostmapClient
@@ -46,6 +48,7 @@ class VoxelLayerScanTest(unittest.TestCase):
             ]
         )
         cls.pub = rospy.Publisher("/scan", LaserScan, queue_size=5)
+        cls.bump = rospy.Publisher("/bump", PointCloud, queue_size=5)
         cls.costmap = CostmapClient("/costmap/costmap")
 
     def publish(self, wall: bool, seconds: float) -> None:
@@ -80,6 +83,29 @@ class VoxelLayerScanTest(unittest.TestCase):
         self.publish(wall=False, seconds=3.0)
         self.assertEqual(self.costmap.cell(1.52, 0.0), FREE)
         self.assertEqual(self.costmap.cell(2.5, 0.0), FREE)  # beyond the wall, now seen
+
+    def test_point_cloud_band_and_footprint(self) -> None:
+        self.assertTrue(wait_until(lambda: self.bump.get_num_connections() > 0, 20.0))
+        # Cell centres (5 cm cells from -3 m), so that no coordinate sits on a cell face.
+        points = [
+            (1.025, -1.025, 0.05),  # inside the source's band [0, 0.15] m: marks
+            (1.025, -1.625, 0.5),  # above it (inside the layer's band): neither marks nor clears
+            (0.225, 0.025, 0.05),  # under the robot (robot_radius 0.46 m): cleared each update
+        ]
+        rate = rospy.Rate(5.0)
+        end = rospy.Time.now() + rospy.Duration(2.0)
+        while rospy.Time.now() < end and not rospy.is_shutdown():
+            msg = PointCloud()
+            msg.header.stamp = rospy.Time.now()
+            msg.header.frame_id = "base_link"
+            msg.points = [Point32(x, y, z) for x, y, z in points]
+            self.bump.publish(msg)
+            rate.sleep()
+        rospy.sleep(1.0)
+        self.assertTrue(wait_until(lambda: self.costmap.received, 10.0), "no costmap")
+        self.assertEqual(self.costmap.cell(1.025, -1.025), LETHAL)
+        self.assertNotEqual(self.costmap.cell(1.025, -1.625), LETHAL)
+        self.assertEqual(self.costmap.cell(0.225, 0.025), FREE)
 
 
 if __name__ == "__main__":

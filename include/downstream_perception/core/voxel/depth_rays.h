@@ -27,4 +27,10 @@ void depthToRays(const float* depth_m, const PinholeCamera& camera,
                  const Eigen::Isometry3d& T_world_camera, bool zero_is_no_return, int stride,
                  DepthRays* out);
 
+/// costmap_2d's per-source height band: removes the points (x, y, z triplets, world frame) whose
+/// finite z lies outside [min_z_m, max_z_m], so that they neither mark nor clear (costmap_2d's
+/// observation buffer drops them). Non-finite points are kept (integrate() counts them invalid).
+/// Returns the number removed; the order of the points kept is unchanged.
+std::size_t dropOutsideHeightBand(std::vector<float>* xyz, double min_z_m, double max_z_m);
+
 }  // namespace downstream_perception

@@ -23,9 +23,11 @@ struct VoxelMapConfig {
   /// A column with MORE than this many occupied voxels in the height band is lethal (costmap_2d
   /// `mark_threshold`). Default 0: one occupied voxel marks.
   int mark_threshold = 0;
-  /// A column with AT MOST this many unknown voxels in the band is known; a known column that is
-  /// not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with
-  /// 10 voxels: every column counts as known, as in costmap_2d).
+  /// A column with AT MOST this many unknown voxels is known; a known column that is not lethal
+  /// is free, any other is unknown (costmap_2d `unknown_threshold`). Counted as costmap_2d
+  /// counts: the band's unknown voxels plus 16 - band when the band has fewer than 16 voxels
+  /// (costmap_2d's 16-bit column). Default 15: with 10 voxels, a column is free once one of its
+  /// voxels is known, and unknown until then.
   int unknown_threshold = 15;
   /// The robot's height band, m: only voxels whose centre lies in [min, max] are projected into
   /// the 2-D costmap (an overhang above the robot is kept in 3-D but ignored). Defaults 0 and 2.

@@ -23,6 +23,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -112,14 +113,27 @@ class VoxelMap {
                                               bool zero_is_no_return, int stride, double stamp_s,
                                               const VoxelRayConfig& rays);
 
+  /// costmap_2d's footprint clearing in 3-D: every band voxel of the given window columns
+  /// (x, y pairs) becomes free (the clamp's minimum), as the robot stands there. Voxels already
+  /// at the minimum are not rewritten when nothing decays. Columns outside the window are
+  /// skipped. Throws std::invalid_argument for a non-finite stamp.
+  VoxelIntegrationStats clearColumns(const std::vector<std::pair<int, int>>& columns,
+                                     double stamp_s);
+
   /// Log-odds of a window voxel at time now_s (decay applied); 0 for an unseen or outside voxel.
   double logOdds(int x, int y, int z, double now_s) const;
   VoxelState state(int x, int y, int z, double now_s) const;
   /// Occupied and unknown voxel counts of a column within the height band.
   VoxelColumn column(int x, int y, double now_s) const;
   /// costmap_2d's column rule: kLethalObstacle when occupied > mark_threshold, else kFreeSpace
-  /// when unknown <= unknown_threshold, else kNoInformation.
+  /// when unknownCount(c) <= unknown_threshold, else kNoInformation.
   std::uint8_t columnCost(const VoxelColumn& c) const;
+  /// The unknown voxels costmap_2d would count for a column: the band's unknown voxels plus, for
+  /// a band of fewer than 16 voxels, the 16 - band bits of costmap_2d's column word that no
+  /// sensor can reach (always unknown there).
+  int unknownCount(const VoxelColumn& c) const;
+  /// Bits per column in costmap_2d's voxel grid (its z_voxels limit).
+  static constexpr int kCostmap2dColumnBits = 16;
   /// Costs of all window columns, row-major (index = y * nx + x), into *costs (resized).
   void project(double now_s, std::vector<std::uint8_t>* costs) const;
   /// Band voxel layers [first, last] (inclusive z indices whose centre is in the height band).
