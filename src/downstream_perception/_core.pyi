@@ -682,7 +682,7 @@ class EsdfConfig:
     @property
     def max_distance_m(self) -> float:
         """
-        Distances are clamped at this (m). Also the reach of a change: a voxel that changes state alters distances within this radius only. (Distances are clamped at this (m). Also the reach of a change: a voxel that changes state alters distances within this radius only. (distances are clamped at this (m); also a change's reach))
+        Distances are clamped at this (m). Also the reach of a change: a voxel that changes state alters distances within this radius only.
         """
     @max_distance_m.setter
     def max_distance_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
@@ -1085,14 +1085,14 @@ class StaticMapConfig:
     @property
     def lethal_cost_threshold(self) -> int:
         """
-        occupancy value (0..100) from which a cell is lethal (occupancy value (0..100) from which a cell is lethal (occupancy value 0..100 (clamped) from which a cell is lethal))
+        occupancy value (0..100) from which a cell is lethal
         """
     @lethal_cost_threshold.setter
     def lethal_cost_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
     def max_cells(self) -> int:
         """
-        Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell here, one in the master, one in each published grid). (Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell here, one in the master, one in each published grid). (largest map accepted, cells))
+        Largest map accepted (cells); a bigger one is refused. Bounds the layer's memory (one byte per cell here, one in the master, one in each published grid).
         """
     @max_cells.setter
     def max_cells(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
@@ -1113,7 +1113,7 @@ class StaticMapConfig:
     @property
     def unknown_cost_value(self) -> int:
         """
-        occupancy value meaning unknown (compared as a byte) (occupancy value meaning unknown (compared as a byte) (occupancy value meaning unknown, compared as a byte (-1 = 255)))
+        occupancy value meaning unknown (compared as a byte)
         """
     @unknown_cost_value.setter
     def unknown_cost_value(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
@@ -1803,7 +1803,7 @@ class VoxelMapConfig:
     @property
     def mark_threshold(self) -> int:
         """
-        A column with MORE than this many occupied voxels in the height band is lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. (A column with MORE than this many occupied voxels in the height band is lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks. (a column with more occupied band voxels than this is lethal))
+        A column with MORE than this many occupied voxels in the height band is lethal (costmap_2d `mark_threshold`). Default 0: one occupied voxel marks.
         """
     @mark_threshold.setter
     def mark_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
@@ -1831,35 +1831,35 @@ class VoxelMapConfig:
     @property
     def origin_z_m(self) -> float:
         """
-        Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0. (Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0. (bottom of voxel layer 0 (m)))
+        Height of the bottom of voxel layer 0, m (costmap_2d `origin_z`). Default 0.
         """
     @origin_z_m.setter
     def origin_z_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def resolution_m(self) -> float:
         """
-        Edge of a voxel in x and y, m (the layer uses the costmap's resolution). Default 0.05. (Edge of a voxel in x and y, m (the layer uses the costmap's resolution). Default 0.05. (voxel edge in x, y (m)))
+        Edge of a voxel in x and y, m (the layer uses the costmap's resolution). Default 0.05.
         """
     @resolution_m.setter
     def resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def unknown_threshold(self) -> int:
         """
-        A column with AT MOST this many unknown voxels in the band is known; a known column that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with 10 voxels: every column counts as known, as in costmap_2d). (A column with AT MOST this many unknown voxels in the band is known; a known column that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Default 15 (with 10 voxels: every column counts as known, as in costmap_2d). (a column with at most this many unknown band voxels is known))
+        A column with AT MOST this many unknown voxels is known; a known column that is not lethal is free, any other is unknown (costmap_2d `unknown_threshold`). Counted as costmap_2d counts: the band's unknown voxels plus 16 - band when the band has fewer than 16 voxels (costmap_2d's 16-bit column). Default 15: with 10 voxels, a column is free once one of its voxels is known, and unknown until then.
         """
     @unknown_threshold.setter
     def unknown_threshold(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
     @property
     def z_resolution_m(self) -> float:
         """
-        Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2. (voxel height (m)))
+        Height of a voxel, m (costmap_2d VoxelLayer `z_resolution`). Default 0.2.
         """
     @z_resolution_m.setter
     def z_resolution_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def z_voxels(self) -> int:
         """
-        Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most kMaxZVoxels). Default 10. (Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most kMaxZVoxels). Default 10. (voxels per column))
+        Voxels per column (costmap_2d `z_voxels`, there at most 16; here at most kMaxZVoxels). Default 10.
         """
     @z_voxels.setter
     def z_voxels(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
@@ -1904,7 +1904,7 @@ class VoxelRayConfig:
     @property
     def one_ray_per_end_voxel(self) -> bool:
         """
-        Of the rays of a frame that end in the same voxel, cast only the first (every return still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour). (Of the rays of a frame that end in the same voxel, cast only the first (every return still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour). (cast only the first ray of a frame ending in each voxel))
+        Of the rays of a frame that end in the same voxel, cast only the first (every return still marks). Each cast ray is still walked exactly; a voxel crossed only by a skipped ray (beside the cast one, near the end, where rays to one voxel diverge by less than a voxel) is not cleared in that frame. Trades that for far fewer rays: a 640x480 depth image has ~40 pixels per 5 cm voxel at 4 m. Default false (every ray exact, costmap_2d's behaviour).
         """
     @one_ray_per_end_voxel.setter
     def one_ray_per_end_voxel(self, arg0: bool) -> None: ...
@@ -1934,6 +1934,14 @@ class VoxelMap:
     def clear(self) -> None:
         """
         Forgets everything (all voxels unknown).
+        """
+    def clear_columns(
+        self,
+        columns: typing.Annotated[numpy.typing.ArrayLike, numpy.int64],
+        stamp_s: typing.SupportsFloat | typing.SupportsIndex,
+    ) -> dict:
+        """
+        costmap_2d's footprint clearing in 3-D: every band voxel of the given window columns (N x 2: x, y) becomes free; columns outside the window are skipped. Returns the counts.
         """
     def column(
         self,

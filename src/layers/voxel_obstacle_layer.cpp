@@ -156,6 +156,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
     reader.get("inf_is_valid", &s->scan_options.inf_is_valid);
     reader.get("inf_is_no_return", &s->scan_options.inf_is_no_return);
     reader.get("range_max_is_no_return", &s->scan_options.range_max_is_no_return);
+    reader.get("per_beam_time_correction", &s->per_beam_time_correction);
     if (s->scan_options.inf_is_valid && s->scan_options.inf_is_no_return) {
       const std::string msg =
           "source '" + name +
@@ -303,6 +304,20 @@ bool VoxelObstacleLayer::lookup(Source* s, const std::string& frame, const ros::
   }
 }
 
+bool VoxelObstacleLayer::lookupQuiet(const std::string& frame, const ros::Time& stamp,
+                                     Eigen::Isometry3d* pose) {
+  try {
+    const auto t = tf_->lookupTransform(layered_costmap_->globalFrame(), frame, stamp);
+    const auto& q = t.transform.rotation;
+    const auto& v = t.transform.translation;
+    pose->linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+    pose->translation() = Eigen::Vector3d(v.x, v.y, v.z);
+    return pose->matrix().allFinite();
+  } catch (const tf2::TransformException&) {
+    return false;
+  }
+}
+
 void VoxelObstacleLayer::onCameraInfo(Source* s, const sensor_msgs::CameraInfoConstPtr& msg) {
   PinholeCamera cam;
   cam.fx = msg->K[0];
@@ -370,14 +385,27 @@ void VoxelObstacleLayer::onScan(Source* s, const sensor_msgs::LaserScanConstPtr&
   }
   const LaserScanView view{msg->ranges.data(),   msg->ranges.size(), msg->angle_min,
                            msg->angle_increment, msg->range_min,     msg->range_max};
-  // One pose for the sweep (no per-beam time correction here, unlike the obstacle layer).
+  const std::string& frame = s->sensor_frame.empty() ? msg->header.frame_id : s->sensor_frame;
   Eigen::Isometry3d pose;
-  if (!lookup(s, s->sensor_frame.empty() ? msg->header.frame_id : s->sensor_frame,
-              msg->header.stamp, &pose)) {
-    return;
+  if (!lookup(s, frame, msg->header.stamp, &pose)) return;
+  // REP 117: the header stamp is the first beam's time, beam k is k * time_increment later. Each
+  // beam's end is placed at its own time, as costmap_2d's laser_geometry projection does; the
+  // rays start from the sensor at the header stamp, as there.
+  Eigen::Isometry3d last = pose;
+  const double sweep_s = msg->time_increment * static_cast<double>(msg->ranges.size() - 1);
+  if (s->per_beam_time_correction && sweep_s != 0.0 && msg->ranges.size() > 1) {
+    if (sweep_s > s->tf_tolerance_s) {
+      s->tf_tolerance_s = sweep_s;  // from now on wait for tf at the last beam too
+      s->scan_sub.setTolerance(ros::Duration(sweep_s));
+    }
+    if (!lookupQuiet(frame, msg->header.stamp + ros::Duration(sweep_s), &last)) {
+      last = pose;
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++s->deskew_skipped;
+    }
   }
   DepthRays rays;
-  scanToRays(view, pose, s->scan_options, &rays);
+  scanToRays(view, pose, last, s->scan_options, &rays);
   integrate(s, pose.translation(), rays.hits, rays.no_returns, msg->header.stamp);
 }
 
@@ -639,6 +667,8 @@ void VoxelObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
     status.add(p + "integrated", s->integrated);
     status.add(p + "refused", s->rejected);
     status.add(p + "points outside height band", s->outside_band);
+    if (s->scan)
+      status.add(p + "per-beam correction skipped (no tf at the last beam)", s->deskew_skipped);
     if (!s->last_rejection.empty()) status.add(p + "last refusal", s->last_rejection);
     status.add(p + "last rays", s->last.rays);
     status.add(p + "last voxels marked", s->last.marked);

@@ -65,6 +65,9 @@ class VoxelObstacleLayer : public Layer {
     double min_z_m = 0.0;
     double max_z_m = 2.0;
     ScanRayOptions scan_options;  ///< LaserScan: +Inf and range_max readings
+    /// LaserScan: each beam's end at its own time (time_increment), as costmap_2d projects.
+    bool per_beam_time_correction = true;
+    double tf_tolerance_s = 0.0;  ///< how long past the stamp the tf filter waits (the sweep)
     bool zero_is_no_return = false;
     bool frustum = false;  ///< clearing_mode frustum (depth sources)
     int stride = 1;
@@ -80,7 +83,8 @@ class VoxelObstacleLayer : public Layer {
     std::size_t received = 0;
     std::size_t integrated = 0;
     std::size_t rejected = 0;
-    std::size_t outside_band = 0;  ///< points dropped by the source's height band
+    std::size_t outside_band = 0;    ///< points dropped by the source's height band
+    std::size_t deskew_skipped = 0;  ///< scans integrated with one pose (no tf at the last beam)
     std::string last_rejection;
     VoxelIntegrationStats last;
     TimingStats integrate_ms;
@@ -96,6 +100,8 @@ class VoxelObstacleLayer : public Layer {
   void reject(Source* s, const std::string& why);
   /// sensor -> global at the stamp; false (and a rejection) when tf cannot give it.
   bool lookup(Source* s, const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
+  /// The same without a rejection: false if tf cannot give a finite transform.
+  bool lookupQuiet(const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
   /// Drops the hits outside the source's height band, then integrates (hits is modified).
   void integrate(Source* s, const Eigen::Vector3d& origin, std::vector<float>& hits,
                  const std::vector<float>& no_returns, const ros::Time& stamp);

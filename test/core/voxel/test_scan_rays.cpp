@@ -141,3 +141,35 @@ TEST(ScanRays, InfIsValidKeepsCostmap2dMeaning) {
   EXPECT_EQ(out.hits.size(), 6u);
   EXPECT_EQ(out.no_returns.size(), 3u);
 }
+
+TEST(ScanRays, MovingSensorInterpolatesEachBeamsPose) {
+  // Three beams of 1 m at 0, -45 and -90 degrees while the sensor moves 0.6 m along the world's x
+  // and turns 90 degrees left: beam 1 is taken halfway, from (0.3, 0, 0) turned 45 degrees, beam 2
+  // from (0.6, 0, 0) turned 90, so every beam points along the world's +x.
+  const std::vector<float> ranges = {1.0f, 1.0f, 1.0f};
+  LaserScanView s;
+  s.ranges = ranges.data();
+  s.count = ranges.size();
+  s.angle_min = 0.0;
+  s.angle_increment = -M_PI / 4;
+  s.range_min = 0.1;
+  s.range_max = 5.0;
+  const Eigen::Isometry3d first = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d last = Eigen::Isometry3d::Identity();
+  last.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).matrix();
+  last.translation() = Eigen::Vector3d(0.6, 0.0, 0.0);
+  DepthRays rays;
+  scanToRays(s, first, last, ScanRayOptions{}, &rays);
+  ASSERT_EQ(rays.hits.size(), 9u);
+  expectPoint(rays.hits, 0, 1.0, 0.0, 0.0);
+  expectPoint(rays.hits, 1, 1.3, 0.0, 0.0);
+  expectPoint(rays.hits, 2, 1.6, 0.0, 0.0);
+  // The same pose twice is the still sensor's result.
+  DepthRays still, same;
+  scanToRays(view(), pose(), ScanRayOptions{}, &still);
+  scanToRays(view(), pose(), pose(), ScanRayOptions{}, &same);
+  EXPECT_EQ(still.hits, same.hits);
+  Eigen::Isometry3d bad = last;
+  bad.translation().x() = std::nan("");
+  EXPECT_THROW(scanToRays(s, first, bad, ScanRayOptions{}, &rays), std::invalid_argument);
+}

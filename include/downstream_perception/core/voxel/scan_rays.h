@@ -29,5 +29,11 @@ struct ScanRayOptions {
 /// std::invalid_argument for a scan that fails LaserScanView::validate() or a non-finite pose.
 void scanToRays(const LaserScanView& scan, const Eigen::Isometry3d& T_world_sensor,
                 const ScanRayOptions& options, DepthRays* out);
+/// The same for a sensor that moves during the sweep: beam k's pose is interpolated between the
+/// first beam's (T_world_first, at the header stamp) and the last beam's (T_world_last), linearly
+/// in translation and by slerp in rotation, at k / (count - 1). Throws as above.
+void scanToRays(const LaserScanView& scan, const Eigen::Isometry3d& T_world_first,
+                const Eigen::Isometry3d& T_world_last, const ScanRayOptions& options,
+                DepthRays* out);
 
 }  // namespace downstream_perception
