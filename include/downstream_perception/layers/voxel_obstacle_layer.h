@@ -46,6 +46,7 @@ class VoxelObstacleLayer : public Layer {
   void deactivate() override;
   void onClockJump() override;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) override;
+  std::string notCurrentReason() const override;
 
  protected:
   void onInitialize() override;
@@ -83,8 +84,11 @@ class VoxelObstacleLayer : public Layer {
     std::size_t received = 0;
     std::size_t integrated = 0;
     std::size_t rejected = 0;
-    std::size_t outside_band = 0;    ///< points dropped by the source's height band
-    std::size_t deskew_skipped = 0;  ///< scans integrated with one pose (no tf at the last beam)
+    std::size_t outside_band = 0;  ///< points dropped by the source's height band
+    std::size_t deskew_skipped = 0;
+    double expected_update_rate_s = 0.0;  ///< costmap_2d's key: 0 = not checked
+    ros::WallTime subscribed_since;       ///< zero while not subscribed
+    ros::WallTime last_integrated;  ///< scans integrated with one pose (no tf at the last beam)
     std::string last_rejection;
     VoxelIntegrationStats last;
     TimingStats integrate_ms;
@@ -113,7 +117,11 @@ class VoxelObstacleLayer : public Layer {
                       const std::function<VoxelIntegrationStats()>& work);
   void publishVoxels(const ros::Time& stamp);
 
-  std::mutex mutex_;
+  /// "" while every source with an expected_update_rate delivers in time, else why not.
+  std::string staleSources() const;
+
+  mutable std::mutex mutex_;
+  std::string not_current_why_;
   VoxelMapConfig config_;
   std::unique_ptr<VoxelMap> map_;
   std::vector<std::unique_ptr<Source>> sources_;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """rostest: a LaserScan source of the VoxelObstacleLayer marks, clears and leaves unseen space
 unknown; a sensor_msgs/PointCloud source (costmap_2d's default data_type) marks within its own
-height band only, and the robot's footprint is cleared (costmap_2d's footprint_clearing_enabled).
+height band only, and the robot's footprint is cleared (costmap_2d's footprint_clearing_enabled);
+a source silent for longer than its expected_update_rate makes the layer not current.
 
 The scanner sits 0.3 m above the odom origin looking along +x with beams from -90 to +90 degrees.
 A wall at x = 1.525 m answers the beams within 60 degrees of the axis; the others see nothing (+Inf,
@@ -11,11 +12,13 @@ inf_is_no_return: they clear to raytrace_range, 3 m).
 from __future__ import annotations
 
 import math
+import threading
 import unittest
 
 import numpy as np
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import Point32
 from sensor_msgs.msg import LaserScan, PointCloud
 from tf2_ros import StaticTransformBroadcaster
@@ -50,6 +53,23 @@ class VoxelLayerScanTest(unittest.TestCase):
         cls.pub = rospy.Publisher("/scan", LaserScan, queue_size=5)
         cls.bump = rospy.Publisher("/bump", PointCloud, queue_size=5)
         cls.costmap = CostmapClient("/costmap/costmap")
+        cls.lock = threading.Lock()
+        cls.status: dict[str, DiagnosticStatus] = {}
+        rospy.Subscriber("/diagnostics", DiagnosticArray, cls.on_diagnostics, queue_size=20)
+
+    @classmethod
+    def on_diagnostics(cls, msg: DiagnosticArray) -> None:
+        with cls.lock:
+            for status in msg.status:
+                cls.status[status.name] = status
+
+    def message_of(self, suffix: str) -> tuple[int, str]:
+        """(level, message) of the latest status whose name ends with `suffix`."""
+        with self.lock:
+            for name, status in self.status.items():
+                if name.endswith(suffix):
+                    return status.level, status.message
+        return -1, ""
 
     def publish(self, wall: bool, seconds: float) -> None:
         rate = rospy.Rate(5.0)
@@ -106,6 +126,19 @@ class VoxelLayerScanTest(unittest.TestCase):
         self.assertEqual(self.costmap.cell(1.025, -1.025), LETHAL)
         self.assertNotEqual(self.costmap.cell(1.025, -1.625), LETHAL)
         self.assertEqual(self.costmap.cell(0.225, 0.025), FREE)
+
+    def test_silent_source_makes_the_layer_not_current(self) -> None:
+        def named() -> bool:
+            level, message = self.message_of("layer voxels")
+            return level == DiagnosticStatus.WARN and "source 'silent' (/silent)" in message
+
+        self.assertTrue(wait_until(named, 20.0), str(self.message_of("layer voxels")))
+        self.assertIn("expected_update_rate 0.50 s", self.message_of("layer voxels")[1])
+        # The costmap's own summary names it too (costmap_2d: "not current" stops move_base).
+        self.assertTrue(
+            wait_until(lambda: "source 'silent'" in self.message_of(": costmap")[1], 10.0),
+            str(self.message_of(": costmap")),
+        )
 
 
 if __name__ == "__main__":
