@@ -1456,6 +1456,13 @@ class TrackerConfig:
     @class_aware.setter
     def class_aware(self, arg0: bool) -> None: ...
     @property
+    def confirm_at_start(self) -> bool:
+        """
+        Start-up confirmation (ByteTrack's frame-1 rule): in the tracker's first frame (the first step() after construction or reset()), a track born from a detection whose score is at least start_confirm_score is confirmed at once instead of waiting min_hits updates. Tracks born later, and first-frame ones below the score, follow min_hits. Only the first step() counts, even when it holds no detections.
+        """
+    @confirm_at_start.setter
+    def confirm_at_start(self, arg0: bool) -> None: ...
+    @property
     def duplicate_confidence(self) -> float:
         """
         Metric mode: a coasting track this close (chi-square gate, 2 dof, sum of both position covariances) to a track born while it coasted and updated this frame is its duplicate and is removed. 0.9 -> 4.61, about 0.3 m at 0.1 m uncertainty.
@@ -1539,6 +1546,13 @@ class TrackerConfig:
         """
     @second_pass.setter
     def second_pass(self, arg0: bool) -> None: ...
+    @property
+    def start_confirm_score(self) -> float:
+        """
+        Score in [0, 1] a first-frame detection needs for start-up confirmation. ByteTrack's det_thresh = track_thresh + 0.1: 0.6 with high_score 0.5. Births need high_score anyway.
+        """
+    @start_confirm_score.setter
+    def start_confirm_score(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
 
 class TrackerStats:
     """

@@ -232,6 +232,17 @@ void bindTracking(py::module& m) {
       .def_readwrite("min_hits", &TrackerConfig::min_hits,
                      "Updates before a track is confirmed; a tentative track that misses one is "
                      "dropped. Image default 2 (see defaultsFor).")
+      .def_readwrite(
+          "confirm_at_start", &TrackerConfig::confirm_at_start,
+          "Start-up confirmation (ByteTrack's frame-1 rule): in the tracker's first frame (the "
+          "first step() after construction or reset()), a track born from a detection whose "
+          "score is at least start_confirm_score is confirmed at once instead of waiting "
+          "min_hits updates. Tracks born later, and first-frame ones below the score, follow "
+          "min_hits. Only the first step() counts, even when it holds no detections.")
+      .def_readwrite("start_confirm_score", &TrackerConfig::start_confirm_score,
+                     "Score in [0, 1] a first-frame detection needs for start-up confirmation. "
+                     "ByteTrack's det_thresh = track_thresh + 0.1: 0.6 with high_score 0.5. "
+                     "Births need high_score anyway.")
       .def_readwrite("max_age_s", &TrackerConfig::max_age_s,
                      "s a confirmed track coasts without detections (both modes)")
       .def_readwrite("high_score", &TrackerConfig::high_score,

@@ -159,3 +159,44 @@ def test_tracks_can_leave_out_tentative_tracks() -> None:
     for k in (1, 2):
         tracker.step(0.1 * k, np.array([[0.0, 0.0]]))
     assert tracker.tracks(include_tentative=False)["state"].tolist() == [1]
+
+
+def state_of(tracker: dp.Tracker, detection: int) -> int:
+    """State of the track that took `detection` in the last step."""
+    track_id = int(tracker.last_assignment()[detection])
+    tracks = tracker.tracks()
+    return int(tracks["state"][tracks["id"] == track_id][0])
+
+
+@pytest.mark.parametrize("mode", ["METRIC", "IMAGE"])
+def test_start_confirmation_through_the_binding(mode: str) -> None:
+    # Issue 21: ByteTrack activates the tracks of its first frame at once (score >= its
+    # track_thresh + 0.1); confirm_at_start does the same for the first step after construction
+    # or reset(), later births wait min_hits.
+    config = dp.TrackerConfig.defaults_for(getattr(dp.TrackerConfig.Mode, mode))
+    config.min_hits = 3
+    config.confirm_at_start = True
+    config.start_confirm_score = 0.7
+    if mode == "IMAGE":
+        first = np.array([[100.0, 100.0, 140.0, 200.0], [300.0, 100.0, 340.0, 200.0]])
+        later = np.vstack([first, [[500.0, 100.0, 540.0, 200.0]]])
+    else:
+        first = np.array([[0.0, 0.0], [5.0, 0.0]])
+        later = np.vstack([first, [[10.0, 0.0]]])
+    confirmed, tentative = int(dp.TrackState.CONFIRMED), int(dp.TrackState.TENTATIVE)
+    tracker = dp.Tracker(config)
+    stats = tracker.step(0.0, first, scores=np.array([0.7, 0.65]))  # at and below the score
+    assert stats.confirmed == 1
+    assert [state_of(tracker, 0), state_of(tracker, 1)] == [confirmed, tentative]
+    tracker.step(0.04, later, scores=np.full(3, 0.9))
+    assert state_of(tracker, 2) == tentative  # born in the second frame
+    tracker.reset()  # re-arms the rule
+    tracker.step(1.0, first[:1], scores=np.array([0.9]))
+    assert state_of(tracker, 0) == confirmed
+    config.confirm_at_start = False
+    plain = dp.Tracker(config)
+    plain.step(0.0, first[:1], scores=np.array([0.9]))
+    assert state_of(plain, 0) == tentative
+    config.start_confirm_score = 1.5
+    with pytest.raises(ValueError):
+        dp.Tracker(config)

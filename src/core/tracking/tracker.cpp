@@ -31,6 +31,8 @@ std::string TrackerConfig::validate() const {
     why << "initial_velocity_std must be in (0, 1e6], got " << initial_velocity_std;
   } else if (min_hits < 1 || min_hits > 1000) {
     why << "min_hits must be in [1, 1000], got " << min_hits;
+  } else if (!(start_confirm_score >= 0.0 && start_confirm_score <= 1.0)) {
+    why << "start_confirm_score must be in [0, 1], got " << start_confirm_score;
   } else if (!(max_age_s >= 0.0 && max_age_s <= kMaxAgeS)) {
     // Bounded: coasting tracks are memory, and one that never dies keeps a slot forever.
     why << "max_age_s must be in [0, 3600] s, got " << max_age_s;
@@ -43,7 +45,10 @@ std::string TrackerConfig::validate() const {
 TrackerConfig TrackerConfig::defaultsFor(Mode mode) {
   TrackerConfig config;
   config.mode = mode;
-  if (mode == Mode::kImage) config.min_hits = 2;
+  if (mode == Mode::kImage) {
+    config.min_hits = 2;
+    config.confirm_at_start = true;
+  }
   return config;
 }
 
@@ -60,6 +65,8 @@ std::vector<std::pair<std::string, double>> TrackerConfig::modeSpecificDefaults(
       {"measurement_std", {metric.measurement_std, own.measurement_std}},
       {"initial_velocity_std", {metric.initial_velocity_std, own.initial_velocity_std}},
       {"min_hits", {metric.min_hits, own.min_hits}},
+      {"confirm_at_start", {metric.confirm_at_start, own.confirm_at_start}},
+      {"start_confirm_score", {metric.start_confirm_score, own.start_confirm_score}},
       {"max_age_s", {metric.max_age_s, own.max_age_s}},
       {"high_score", {metric.high_score, own.high_score}},
       {"low_score", {metric.low_score, own.low_score}},
@@ -447,6 +454,7 @@ struct Core : Tracker::Impl {
   };
 
   TrackerStats step(double now, const std::vector<Detection>& detections) override {
+    const bool first_frame = !started;  // the first step since construction or reset()
     const double dt = advanceClock(now);
     TrackerStats stats;
     stats.detections = detections.size();
@@ -455,7 +463,7 @@ struct Core : Tracker::Impl {
     associateAll(detections, &frame, &stats);
     updateOrRetireTracks(detections, now, &frame, &stats);
     mergeReturningTracks(frame.newcomers, now, &stats);
-    bearTracks(detections, now, frame, &stats);
+    bearTracks(detections, now, first_frame, frame, &stats);
     publish(detections.size(), now, &stats);
     return stats;
   }
@@ -618,9 +626,18 @@ struct Core : Tracker::Impl {
     stats->deaths += stats->duplicates_removed;
   }
 
+  // A new track's state: confirmed at once with min_hits 1, or in the first frame for a score
+  // that passes start_confirm_score (ByteTrack activates its frame-1 tracks at once); else
+  // tentative until min_hits updates.
+  TrackState birthState(const Detection& d, bool first_frame) const {
+    const bool at_start =
+        first_frame && config.confirm_at_start && d.score >= config.start_confirm_score;
+    return config.min_hits <= 1 || at_start ? TrackState::kConfirmed : TrackState::kTentative;
+  }
+
   // Births from high-score detections no track took.
-  void bearTracks(const std::vector<Detection>& detections, double now, const Frame& frame,
-                  TrackerStats* stats) {
+  void bearTracks(const std::vector<Detection>& detections, double now, bool first_frame,
+                  const Frame& frame, TrackerStats* stats) {
     for (const std::size_t j : frame.high) {
       if (frame.track_of_det[j] >= 0) continue;
       ++stats->unmatched_outside_gate;
@@ -628,7 +645,7 @@ struct Core : Tracker::Impl {
       Track track;
       track.id = next_id++;
       track.class_id = d.class_id;
-      track.state = config.min_hits <= 1 ? TrackState::kConfirmed : TrackState::kTentative;
+      track.state = birthState(d, first_frame);
       track.hits = 1;
       track.score = d.score;
       track.truth_id = d.truth_id;

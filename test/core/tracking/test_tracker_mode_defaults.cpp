@@ -52,6 +52,8 @@ TEST(TrackerModeDefaults, ImageModeListsExactlyTheFieldsItChanges) {
   for (const auto& [name, value] : differing) {
     if (name == "min_hits") {
       rebuilt.min_hits = static_cast<int>(value);
+    } else if (name == "confirm_at_start") {
+      rebuilt.confirm_at_start = value != 0.0;
     } else if (name == "max_age_s") {
       rebuilt.max_age_s = value;
     } else if (name == "accel_psd") {
@@ -67,6 +69,7 @@ TEST(TrackerModeDefaults, ImageModeListsExactlyTheFieldsItChanges) {
     }
   }
   EXPECT_EQ(rebuilt.min_hits, image.min_hits);
+  EXPECT_EQ(rebuilt.confirm_at_start, image.confirm_at_start);
   EXPECT_EQ(rebuilt.max_age_s, image.max_age_s);
   EXPECT_EQ(rebuilt.accel_psd, image.accel_psd);
   EXPECT_EQ(rebuilt.measurement_std, image.measurement_std);
@@ -75,8 +78,12 @@ TEST(TrackerModeDefaults, ImageModeListsExactlyTheFieldsItChanges) {
 }
 
 TEST(TrackerModeDefaults, ImageDefaultsConfirmAfterMinHitsWhileAHandSetModeKeepsTheOldOnes) {
-  const TrackerConfig image = TrackerConfig::defaultsFor(TrackerConfig::Mode::kImage);
+  // Without start-up confirmation (image default on: a first-frame track is confirmed at once,
+  // test_tracker_start_confirmation.cpp) the count of updates decides.
+  TrackerConfig image = TrackerConfig::defaultsFor(TrackerConfig::Mode::kImage);
   ASSERT_LT(image.min_hits, TrackerConfig{}.min_hits);
+  EXPECT_EQ(stateAfter(image, 1), TrackState::kConfirmed);
+  image.confirm_at_start = false;
   EXPECT_EQ(stateAfter(image, image.min_hits - 1), TrackState::kTentative);
   EXPECT_EQ(stateAfter(image, image.min_hits), TrackState::kConfirmed);
   // Setting only the mode on a default config (what existing code does) keeps min_hits 3.

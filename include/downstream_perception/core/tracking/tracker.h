@@ -13,7 +13,8 @@
 //  - ByteTrack's second pass: detections below `high_score` may still continue existing tracks
 //    (never start new ones).
 // Ids are never reused. Track states: tentative until min_hits updates (a tentative track that
-// misses an update is dropped), then confirmed; a confirmed track without a detection coasts
+// misses an update is dropped; with confirm_at_start, first-frame births with a high enough
+// score skip this), then confirmed; a confirmed track without a detection coasts
 // (prediction only) up to max_age_s and is then deleted.
 #pragma once
 
@@ -87,6 +88,18 @@ struct TrackerConfig {
   /// Updates before a track is confirmed; a tentative track that misses one is dropped. Image
   /// default 2 (see defaultsFor).
   int min_hits = 3;
+  /// Start-up confirmation (ByteTrack's frame-1 rule): in the tracker's first frame (the first
+  /// step() after construction or reset()), a track born from a detection whose score is at
+  /// least start_confirm_score is confirmed at once instead of waiting min_hits updates, so the
+  /// objects present at start-up are reported from the first frame, as ByteTrack and SORT do.
+  /// Tracks born later, and first-frame ones below the score, follow min_hits. Only the first
+  /// step() counts, even when it holds no detections (ByteTrack's frame_id == 1). Image default
+  /// true, metric false (see defaultsFor): on the metric scenes it gained MOTA and IDF1 but
+  /// added ID switches (docs/tracker.md).
+  bool confirm_at_start = false;
+  /// Score in [0, 1] a first-frame detection needs for start-up confirmation. ByteTrack's
+  /// det_thresh = track_thresh + 0.1: 0.6 with high_score 0.5. Births need high_score anyway.
+  double start_confirm_score = 0.6;
   double max_age_s = 1.5;   ///< s a confirmed track coasts without detections (both modes)
   double high_score = 0.5;  ///< detections at or above: first pass, may start tracks
   double low_score = 0.1;   ///< below: ignored; in between: second pass only
@@ -100,9 +113,11 @@ struct TrackerConfig {
   /// pinhole scenes of sim.image_scene, several seeds, 25 and 30 fps; docs/tracker.md, "Tracking
   /// core"): the same noise levels read in box heights, and min_hits 2, because with 3 a person who
   /// is missed once in the first frames is dropped and found again frames later (recall).
+  /// Image mode also confirms first-frame tracks at once (confirm_at_start), as ByteTrack does.
   static TrackerConfig defaultsFor(Mode mode);
   /// The parameters whose default in `mode` differs from the metric one, by their YAML / field
-  /// name, with the mode's value: what a node applies to the keys its user left unset.
+  /// name, with the mode's value (a bool as 0 / 1): what a node applies to the keys its user left
+  /// unset.
   static std::vector<std::pair<std::string, double>> modeSpecificDefaults(Mode mode);
 };
 
