@@ -27,7 +27,83 @@ constexpr double kVoxelCloudPeriodS = 0.5;
 
 VoxelObstacleLayer::~VoxelObstacleLayer() {
   // Stop the callbacks before the map they write into goes away.
+  reconfigure_.stop();
   sources_.clear();
+}
+
+void VoxelObstacleLayer::reconfigure(VoxelObstacleLayerConfig& cfg, std::uint32_t) {
+  // A rejected value is written back into `cfg` (the server then shows the value in use); its
+  // error stays in diagnostics until a valid value is set.
+  VoxelMapConfig in_use;
+  int combination_in_use = 1;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    in_use = config_;
+    combination_in_use = combination_method_;
+  }
+  VoxelMapConfig want = in_use;
+  want.origin_z_m = cfg.origin_z;
+  want.z_resolution_m = cfg.z_resolution;
+  want.z_voxels = cfg.z_voxels;
+  want.unknown_threshold = cfg.unknown_threshold;
+  want.mark_threshold = cfg.mark_threshold;
+  want.min_obstacle_height_m = cfg.min_obstacle_height;
+  want.max_obstacle_height_m = cfg.max_obstacle_height;
+  want.decay_time_s = cfg.decay_time_s;
+  const bool changed =
+      want.origin_z_m != in_use.origin_z_m || want.z_resolution_m != in_use.z_resolution_m ||
+      want.z_voxels != in_use.z_voxels || want.unknown_threshold != in_use.unknown_threshold ||
+      want.mark_threshold != in_use.mark_threshold ||
+      want.min_obstacle_height_m != in_use.min_obstacle_height_m ||
+      want.max_obstacle_height_m != in_use.max_obstacle_height_m ||
+      want.decay_time_s != in_use.decay_time_s;
+  bool rebuild = false;
+  if (changed) {
+    const std::string why = want.validate();
+    if (why.empty()) {
+      config_errors_.clear("voxel map");
+      rebuild = true;
+    } else {
+      config_errors_.set("voxel map", "voxel map invalid (" + why + "); keeping the previous one");
+      cfg.origin_z = in_use.origin_z_m;
+      cfg.z_resolution = in_use.z_resolution_m;
+      cfg.z_voxels = in_use.z_voxels;
+      cfg.unknown_threshold = in_use.unknown_threshold;
+      cfg.mark_threshold = in_use.mark_threshold;
+      cfg.min_obstacle_height = in_use.min_obstacle_height_m;
+      cfg.max_obstacle_height = in_use.max_obstacle_height_m;
+      cfg.decay_time_s = in_use.decay_time_s;
+      want = in_use;
+    }
+  }
+  if (cfg.combination_method != combination_in_use) {
+    if (cfg.combination_method == 0 || cfg.combination_method == 1) {
+      config_errors_.clear("combination_method");
+    } else {
+      config_errors_.set("combination_method",
+                         "combination_method must be 0 (overwrite) or 1 (maximum), got " +
+                             std::to_string(cfg.combination_method) + "; keeping " +
+                             std::to_string(combination_in_use));
+      cfg.combination_method = combination_in_use;
+    }
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    config_ = want;
+    combination_method_ = cfg.combination_method;
+    footprint_clearing_enabled_ = cfg.footprint_clearing_enabled;
+    redraw_all_ = true;
+  }
+  // costmap_2d's VoxelLayer resets its grid on a change too (matchSize).
+  if (rebuild) matchSize();
+  const bool was_enabled = enabled_;
+  enabled_ = cfg.enabled;
+  if (enabled_) {
+    activate();
+  } else {
+    deactivate();
+  }
+  if (was_enabled != enabled_ || rebuild) layered_costmap_->requestFullRedraw();
 }
 
 void VoxelObstacleLayer::onInitialize() {
@@ -36,12 +112,10 @@ void VoxelObstacleLayer::onInitialize() {
   track_unknown_space_ = layered_costmap_->isTrackingUnknown();
   reader.get("enabled", &enabled_);
   reader.get("track_unknown_space", &track_unknown_space_);
+  // The dynamic_reconfigure keys (cfg/VoxelObstacleLayer.cfg) are type-checked here (the server
+  // drops a wrong-typed value without a word) and applied by reconfigure(), called by the server
+  // at start-up with the YAML's values and on every change.
   reader.get("combination_method", &combination_method_);
-  if (combination_method_ != 0 && combination_method_ != 1) {
-    config_errors_.add("combination_method must be 0 (overwrite) or 1 (maximum), got " +
-                       std::to_string(combination_method_) + "; using 1");
-    combination_method_ = 1;
-  }
   // costmap_2d VoxelLayer's keys, with its defaults (VoxelMapConfig documents each).
   VoxelMapConfig c;
   reader.get("origin_z", &c.origin_z_m);
@@ -64,12 +138,13 @@ void VoxelObstacleLayer::onInitialize() {
   c.resolution_m = layered_costmap_->costmap().geometry().resolution();
   const std::string why = c.validate();
   if (!why.empty()) {
-    config_errors_.add("voxel map invalid (" + why + "); using the defaults");
+    config_errors_.set("voxel map", "voxel map invalid (" + why + "); using the defaults");
     const double resolution = c.resolution_m;
     c = VoxelMapConfig();
     c.resolution_m = resolution;
   }
   config_ = c;
+  combination_method_ = 1;  // applied by reconfigure()
   // costmap_2d's layer-level keys read elsewhere: obstacle_range / raytrace_range are found from
   // each source upward (searchParam, readSource); transform_tolerance is validated only (the
   // MessageFilter waits for each message's own transform, as in costmap_2d in practice).
@@ -96,7 +171,10 @@ void VoxelObstacleLayer::onInitialize() {
   param_warnings_ = reader.warnings();
   if (publish_voxel_map_) voxel_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("voxel_cloud", 1);
   matchSize();
-  if (enabled_) activate();
+  const bool enabled = enabled_;
+  enabled_ = false;  // reconfigure() subscribes when it sees the layer enabled
+  reconfigure_.start(nh_, this, &VoxelObstacleLayer::reconfigure);
+  if (enabled && !enabled_) ROS_INFO("layer '%s': disabled by dynamic_reconfigure", name_.c_str());
   ROS_INFO(
       "layer '%s': 3-D voxels %.3f m x %.3f m, %d layers from %.2f m, band [%.2f, %.2f] m, "
       "mark_threshold %d, unknown_threshold %d, decay %.1f s, memory <= %.1f MiB, %zu source(s)",

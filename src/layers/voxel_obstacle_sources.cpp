@@ -131,8 +131,9 @@ void VoxelObstacleLayer::activate() {
   for (auto& sp : sources_) {
     Source* s = sp.get();
     {
+      // Subscribing is idempotent; the update-rate clock starts at the first subscription.
       std::lock_guard<std::mutex> lock(mutex_);
-      s->subscribed_since = ros::WallTime::now();
+      if (s->subscribed_since.isZero()) s->subscribed_since = ros::WallTime::now();
     }
     const auto on_failure =
         [this, s, &frame](const auto& msg, tf2_ros::filter_failure_reasons::FilterFailureReason) {

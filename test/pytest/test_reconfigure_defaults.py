@@ -153,3 +153,24 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
             assert documented[name] == pytest.approx(value) or documented[name] == value, name
     # The OctoMap's cap, start-up only: the YAML's MiB are OctreeConfig's bytes.
     assert documented["octomap_max_memory_mb"] * 2**20 == dp.OctreeConfig().max_memory_bytes
+
+
+def test_voxel_layer_defaults_match_voxel_map_config() -> None:
+    from downstream_perception.cfg import VoxelObstacleLayerConfig
+
+    d = VoxelObstacleLayerConfig.defaults
+    c = dp.VoxelMapConfig()
+    assert (d["origin_z"], d["z_resolution"], d["z_voxels"]) == (
+        c.origin_z_m,
+        c.z_resolution_m,
+        c.z_voxels,
+    )
+    assert (d["mark_threshold"], d["unknown_threshold"]) == (c.mark_threshold, c.unknown_threshold)
+    assert (d["min_obstacle_height"], d["max_obstacle_height"]) == (
+        c.min_obstacle_height_m,
+        c.max_obstacle_height_m,
+    )
+    assert d["decay_time_s"] == c.decay_time_s
+    # costmap_2d VoxelPlugin.cfg's defaults for its own keys.
+    assert d["enabled"] and d["footprint_clearing_enabled"] and d["combination_method"] == 1
+    assert (d["z_voxels"], d["z_resolution"], d["unknown_threshold"]) == (10, 0.2, 15)

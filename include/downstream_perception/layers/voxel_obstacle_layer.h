@@ -23,12 +23,14 @@
 #include <utility>
 #include <vector>
 
+#include "downstream_perception/VoxelObstacleLayerConfig.h"
 #include "downstream_perception/core/running_stats.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/voxel/scan_rays.h"
 #include "downstream_perception/core/voxel/voxel_map.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
+#include "downstream_perception/ros/common/reconfigure_host.h"
 #include "downstream_perception/ros/costmap/layer.h"
 
 namespace downstream_perception {
@@ -117,6 +119,8 @@ class VoxelObstacleLayer : public Layer {
                       const std::function<VoxelIntegrationStats()>& work);
   void publishVoxels(const ros::Time& stamp);
 
+  /// dynamic_reconfigure (cfg/VoxelObstacleLayer.cfg): costmap_2d VoxelPlugin's keys.
+  void reconfigure(VoxelObstacleLayerConfig& cfg, std::uint32_t level);
   /// "" while every source with an expected_update_rate delivers in time, else why not.
   std::string staleSources() const;
 
@@ -143,6 +147,7 @@ class VoxelObstacleLayer : public Layer {
   std::size_t dropped_updates_ = 0;
   ConfigErrorLog config_errors_;
   std::vector<std::string> param_warnings_;
+  ReconfigureHost<VoxelObstacleLayerConfig> reconfigure_;  ///< last member: stopped first
 };
 
 }  // namespace downstream_perception

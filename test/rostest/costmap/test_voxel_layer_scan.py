@@ -2,7 +2,8 @@
 """rostest: a LaserScan source of the VoxelObstacleLayer marks, clears and leaves unseen space
 unknown; a sensor_msgs/PointCloud source (costmap_2d's default data_type) marks within its own
 height band only, and the robot's footprint is cleared (costmap_2d's footprint_clearing_enabled);
-a source silent for longer than its expected_update_rate makes the layer not current.
+a source silent for longer than its expected_update_rate makes the layer not current; a live
+dynamic_reconfigure change rebuilds the map, an invalid one is put back.
 
 The scanner sits 0.3 m above the odom origin looking along +x with beams from -90 to +90 degrees.
 A wall at x = 1.525 m answers the beams within 60 degrees of the axis; the others see nothing (+Inf,
@@ -19,6 +20,7 @@ import numpy as np
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from dynamic_reconfigure.client import Client
 from geometry_msgs.msg import Point32
 from sensor_msgs.msg import LaserScan, PointCloud
 from tf2_ros import StaticTransformBroadcaster
@@ -138,6 +140,27 @@ class VoxelLayerScanTest(unittest.TestCase):
         self.assertTrue(
             wait_until(lambda: "source 'silent'" in self.message_of(": costmap")[1], 10.0),
             str(self.message_of(": costmap")),
+        )
+
+    def test_zz_reconfigure_rebuilds_or_refuses(self) -> None:  # last: it empties the map
+        self.publish(wall=True, seconds=1.5)
+        self.assertEqual(self.costmap.cell(1.52, 0.0), LETHAL)
+        client = Client("/costmap/voxels", timeout=10.0)
+        # An invalid value is refused and put back; the map is kept.
+        config = client.update_configuration({"mark_threshold": -1})
+        self.assertEqual(config["mark_threshold"], 0)
+        self.assertTrue(
+            wait_until(lambda: "voxel map invalid" in self.message_of("layer voxels")[1], 10.0),
+            str(self.message_of("layer voxels")),
+        )
+        rospy.sleep(0.5)
+        self.assertEqual(self.costmap.cell(1.52, 0.0), LETHAL)
+        # A valid change of the column rebuilds the map empty (as costmap_2d resets its grid).
+        config = client.update_configuration({"z_voxels": 12})
+        self.assertEqual(config["z_voxels"], 12)
+        self.assertTrue(
+            wait_until(lambda: self.costmap.cell(1.52, 0.0) == UNKNOWN, 10.0),
+            "the wall survived a change of z_voxels",
         )
 
 
