@@ -25,6 +25,11 @@ void VoxelObstacleLayer::reject(Source* s, const std::string& why) {
 
 bool VoxelObstacleLayer::lookup(Source* s, const std::string& frame, const ros::Time& stamp,
                                 Eigen::Isometry3d* pose) {
+  if (stamp.isZero()) {
+    // tf reads stamp 0 as "latest": exactly the mistake this layer exists to prevent.
+    reject(s, "zero stamp: a message must carry its measurement time");
+    return false;
+  }
   try {
     const auto t = tf_->lookupTransform(layered_costmap_->globalFrame(), frame, stamp);
     const auto& q = t.transform.rotation;

@@ -73,6 +73,14 @@ class VoxelLayerScanTest(unittest.TestCase):
                     return status.level, status.message
         return -1, ""
 
+    def values_of(self, suffix: str) -> str:
+        """The key/values of the latest status whose name ends with `suffix`, as one string."""
+        with self.lock:
+            for name, status in self.status.items():
+                if name.endswith(suffix):
+                    return " | ".join(f"{kv.key}: {kv.value}" for kv in status.values)
+        return ""
+
     def publish(self, wall: bool, seconds: float) -> None:
         rate = rospy.Rate(5.0)
         end = rospy.Time.now() + rospy.Duration(seconds)
@@ -128,6 +136,29 @@ class VoxelLayerScanTest(unittest.TestCase):
         self.assertEqual(self.costmap.cell(1.025, -1.025), LETHAL)
         self.assertNotEqual(self.costmap.cell(1.025, -1.625), LETHAL)
         self.assertEqual(self.costmap.cell(0.225, 0.025), FREE)
+
+    def test_scan_with_zero_stamp_is_refused(self) -> None:
+        self.assertTrue(wait_until(lambda: self.pub.get_num_connections() > 0, 20.0))
+        msg = laser_scan(
+            rospy.Time(0),
+            "laser",
+            wall_ranges(True),
+            float(ANGLES[0]),
+            math.radians(1.0),
+            0.05,
+            10.0,
+        )
+        for _ in range(3):
+            self.pub.publish(msg)
+            rospy.sleep(0.1)
+        self.assertTrue(
+            wait_until(
+                lambda: "zero stamp" in self.message_of("layer voxels")[1]
+                or "zero stamp" in self.values_of("layer voxels"),
+                10.0,
+            ),
+            str(self.message_of("layer voxels")),
+        )
 
     def test_silent_source_makes_the_layer_not_current(self) -> None:
         def named() -> bool:

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""rostest: every malformed PointCloud2 layout reaches all three cloud consumers (obstacle layer,
-handoff relay, TSDF); each refuses every one with a counted reason, and a good cloud sent after
-them is still used by all three (the manager process survived)."""
+"""rostest: every malformed PointCloud2 layout reaches all four cloud consumers (obstacle layer,
+3-D voxel layer, handoff relay, TSDF); each refuses every one with a counted reason, and a good
+cloud sent after them is still used by all four (the manager process survived)."""
 
 from __future__ import annotations
 
@@ -94,7 +94,7 @@ class MalformedCloudsTest(unittest.TestCase):
         rospy.Subscriber("/handoff/clouds_planning", PointCloud2, on_relayed, queue_size=20)
         cls.costmap = CostmapClient("/costmap/costmap")
         cls.pub = rospy.Publisher(TOPIC, PointCloud2, queue_size=50)
-        # The three consumers share the manager process: one connection.
+        # The consumers share the manager process: one connection.
         assert wait_until(lambda: cls.pub.get_num_connections() >= 1, 20.0)
 
     def values(self, status_suffix: str) -> dict[str, str]:
@@ -119,6 +119,7 @@ class MalformedCloudsTest(unittest.TestCase):
             "obstacle layer": lambda: self.count(
                 "costmap: layer obstacles", "points: rejected (bad message: cloud layout)"
             ),
+            "voxel layer": lambda: self.count("costmap: layer voxels", "source 'points' refused"),
             "handoff relay": lambda: self.count("handoff: seam", f"{TOPIC} rejected (malformed)"),
             "tsdf": lambda: self.count("tsdf: tsdf", "rejected (bad point cloud)"),
         }
@@ -128,7 +129,7 @@ class MalformedCloudsTest(unittest.TestCase):
                 f"{consumer} counted {count()} of {n} malformed clouds",
             )
 
-        # All three still use a good cloud.
+        # All four still use a good cloud.
         good = good_cloud(rospy.Time.now())
         with self.lock:
             self.relayed.clear()
@@ -145,6 +146,13 @@ class MalformedCloudsTest(unittest.TestCase):
         self.assertTrue(
             wait_until(lambda: self.count("tsdf: tsdf", "frames integrated") >= 1, 15.0),
             f"the TSDF integrated nothing: {self.values('tsdf: tsdf')}",
+        )
+        self.assertTrue(
+            wait_until(
+                lambda: self.count("costmap: layer voxels", "source 'points' integrated") >= 1,
+                15.0,
+            ),
+            f"the voxel layer integrated nothing: {self.values('costmap: layer voxels')}",
         )
         with self.lock:
             relayed = list(self.relayed)
