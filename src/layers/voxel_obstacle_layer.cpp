@@ -17,6 +17,7 @@
 #include "downstream_perception/ros/common/param_reader.h"
 #include "downstream_perception/ros/common/timing_diagnostics.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
+#include "downstream_perception/ros/costmap/stvl_keys.h"
 
 namespace downstream_perception {
 
@@ -149,6 +150,7 @@ void VoxelObstacleLayer::onInitialize() {
   // each source upward (searchParam, readSource); transform_tolerance is validated only (the
   // MessageFilter waits for each message's own transform, as in costmap_2d in practice).
   reader.known({"obstacle_range", "raytrace_range"});
+  reader.known(stvlLayerKeys());  // an STVL configuration's: adopted by the host (stvl_keys.h)
   double transform_tolerance = 0.2;
   reader.get("transform_tolerance", &transform_tolerance);
   if (!std::isfinite(transform_tolerance) || transform_tolerance < 0.0) {

@@ -9,6 +9,7 @@
 
 #include "downstream_perception/ros/common/param_reader.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
+#include "downstream_perception/ros/costmap/stvl_keys.h"
 
 namespace downstream_perception {
 
@@ -34,6 +35,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   search("raytrace_range", &s->rays.raytrace_max_range_m);
   s->rays.no_return_range_m = s->rays.raytrace_max_range_m;
   reader.known({"obstacle_range", "raytrace_range"});
+  reader.known(stvlSourceKeys());  // an STVL configuration's: adopted by the host
   reader.get("no_return_range", &s->rays.no_return_range_m);
   reader.get("camera_info_topic", &s->camera_info_topic);
   reader.get("zero_is_no_return", &s->zero_is_no_return);
@@ -52,7 +54,13 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
     reader.get("min_obstacle_height", &s->min_z_m);
     reader.get("max_obstacle_height", &s->max_z_m);
   }
-  reader.unsupported("observation_persistence", "each observation is integrated once");
+  // costmap_2d's default 0 (the latest observation only) is what this layer does: only a
+  // longer persistence is a difference.
+  double persistence_s = 0.0;
+  if (reader.get("observation_persistence", &persistence_s) && persistence_s != 0.0) {
+    reader.unsupported("observation_persistence",
+                       "each observation is integrated once (as with 0, costmap_2d's default)");
+  }
   // costmap_2d's rule: the layer (and the costmap) is not current while a source has delivered
   // nothing for longer than this since its last observation or since subscribing.
   reader.get("expected_update_rate", &s->expected_update_rate_s);
@@ -73,7 +81,15 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
       param_warnings_.push_back(msg);
     }
   } else {
-    reader.unsupported("inf_is_valid", "depth images: +Inf is a no-return ray (REP 118)");
+    // costmap_2d reads inf_is_valid for LaserScan sources only; true elsewhere is a difference.
+    bool inf_is_valid = false;
+    if (reader.get("inf_is_valid", &inf_is_valid) && inf_is_valid) {
+      reader.unsupported("inf_is_valid",
+                         data_type == "DepthImage"
+                             ? "depth images: +Inf is a no-return ray (REP 118)"
+                             : "clouds have no ranges to substitute (costmap_2d ignores it "
+                               "there too)");
+    }
   }
   reader.warnUnknown();
   for (const auto& w : reader.warnings()) param_warnings_.push_back("source '" + name + "': " + w);

@@ -1,5 +1,7 @@
 #include "downstream_perception/ros/costmap/costmap_plugin_list.h"
 
+#include "downstream_perception/ros/costmap/stvl_keys.h"
+
 #include <ros/console.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
@@ -18,6 +20,9 @@ const std::map<std::string, std::string>& costmap2dTypes() {
       {"costmap_2d::ObstacleLayer", "downstream_perception/LogOddsObstacleLayer"},
       {"costmap_2d::VoxelLayer", "downstream_perception/VoxelObstacleLayer"},
       {"costmap_2d::InflationLayer", "downstream_perception/InflationLayer"},
+      // The spatio-temporal voxel layer's configurations: its keys are written under ours first
+      // (stvl_keys.h, CostmapRos::loadPlugins), differences named.
+      {kStvlType, "downstream_perception/VoxelObstacleLayer"},
   };
   return types;
 }
@@ -85,7 +90,10 @@ std::string ourLayerType(const std::string& type, std::string* note) {
   if (note) note->clear();
   const auto known = costmap2dTypes().find(type);
   if (known != costmap2dTypes().end()) {
-    if (note) *note = "costmap_2d type '" + type + "' runs as " + known->second;
+    if (note) {
+      *note = std::string(type == kStvlType ? "spatio_temporal_voxel_layer" : "costmap_2d") +
+              " type '" + type + "' runs as " + known->second;
+    }
     return known->second;
   }
   if (type.rfind(kMoveBaseSpelling, 0) == 0) {

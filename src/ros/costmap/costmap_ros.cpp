@@ -11,6 +11,7 @@
 #include "downstream_perception/ros/common/timing_diagnostics.h"
 #include "downstream_perception/ros/costmap/costmap_plugin_list.h"
 #include "downstream_perception/ros/costmap/footprint_params.h"
+#include "downstream_perception/ros/costmap/stvl_keys.h"
 
 namespace downstream_perception {
 
@@ -207,6 +208,12 @@ void CostmapRos::loadPlugins() {
     std::string note;
     const std::string type = ourLayerType(spec.type, &note);
     if (!note.empty()) ROS_INFO("costmap: layer '%s': %s", spec.name.c_str(), note.c_str());
+    if (spec.type == kStvlType) {
+      ros::NodeHandle layer_nh(pnh_, spec.name);
+      const std::vector<std::string> notes =
+          adoptStvlKeys(layer_nh, config_.resolution, "costmap: layer '" + spec.name + "'");
+      for (const auto& n : notes) param_warnings_.push_back("layer '" + spec.name + "': " + n);
+    }
     try {
       std::shared_ptr<Layer> layer = plugin_loader_->createSharedInstance(type);
       layered_costmap_->addPlugin(layer);

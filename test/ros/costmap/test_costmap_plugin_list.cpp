@@ -34,9 +34,11 @@ TEST(OurLayerType, TheMoveBaseSpellingOfOursAndOtherTypes) {
   EXPECT_EQ(ourLayerType("downstream_perception/TsdfLayer", &note),
             "downstream_perception/TsdfLayer");
   EXPECT_EQ(note, "");
-  // Not ours and not one of the four: passed through (pluginlib then names the failure).
+  // The spatio-temporal voxel layer runs as our 3-D voxel layer (its keys adopted by the host).
   EXPECT_EQ(ourLayerType("spatio_temporal_voxel_layer/SpatioTemporalVoxelLayer", &note),
-            "spatio_temporal_voxel_layer/SpatioTemporalVoxelLayer");
+            "downstream_perception/VoxelObstacleLayer");
+  EXPECT_NE(note.find("spatio_temporal_voxel_layer type"), std::string::npos) << note;
+  // Not ours and not one we map: passed through (pluginlib then names the failure).
   EXPECT_EQ(ourLayerType("costmap_2d::RangeSensorLayer"), "costmap_2d::RangeSensorLayer");
 }
 
