@@ -11,6 +11,7 @@
 #include "downstream_perception/layers/static_layer.h"
 #include "downstream_perception/layers/tracked_obstacle_layer.h"
 #include "downstream_perception/layers/tsdf_layer.h"
+#include "downstream_perception/layers/voxel_obstacle_layer.h"
 
 namespace downstream_perception {
 
@@ -205,6 +206,13 @@ class Costmap2dTrackedObstacleLayer : public Costmap2dLayerAdapter {
       : Costmap2dLayerAdapter(std::make_shared<TrackedObstacleLayer>()) {}
 };
 
+/// downstream_perception::VoxelObstacleLayer (3-D voxels, costmap_2d VoxelLayer's keys) for
+/// costmap_2d / move_base.
+class Costmap2dVoxelObstacleLayer : public Costmap2dLayerAdapter {
+ public:
+  Costmap2dVoxelObstacleLayer() : Costmap2dLayerAdapter(std::make_shared<VoxelObstacleLayer>()) {}
+};
+
 }  // namespace downstream_perception
 
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dStaticLayer, costmap_2d::Layer)
@@ -212,3 +220,4 @@ PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dLogOddsObstacleLayer, cos
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dInflationLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dTsdfLayer, costmap_2d::Layer)
 PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dTrackedObstacleLayer, costmap_2d::Layer)
+PLUGINLIB_EXPORT_CLASS(downstream_perception::Costmap2dVoxelObstacleLayer, costmap_2d::Layer)
