@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -62,7 +63,15 @@ VoxelIntegrationStats VoxelMap::integrateDepthFrustum(const float* depth_m,
   const auto nzf = static_cast<float>(config_.z_voxels);
   const auto ifx = static_cast<float>(1.0 / camera.fx);
   const auto ify = static_cast<float>(1.0 / camera.fy);
-  int last = -1;
+  // Voxels marked recently in this frame, direct-mapped by key: noisy depths make neighbouring
+  // pixels alternate between a few voxels, and each repeat would otherwise cost a block lookup
+  // only to find the voxel updated already (updateVoxel's frame tag). Exact: a key is skipped
+  // only if it was updated in this frame.
+  constexpr std::size_t kRecent = 1024;
+  std::array<std::int64_t, kRecent> recent;
+  recent.fill(-1);
+  const auto nx64 = static_cast<std::int64_t>(nx_);
+  const auto nxy64 = nx64 * ny_;
   for (int v = 0; v < camera.height; v += stride) {
     const float ry = (static_cast<float>(v) - static_cast<float>(camera.cy)) * ify;
     const Eigen::Vector3f row_dir = Rf.col(1) * ry + Rf.col(2);
@@ -88,9 +97,10 @@ VoxelIntegrationStats VoxelMap::integrateDepthFrustum(const float* depth_m,
       }
       const int x = static_cast<int>(c.x()), y = static_cast<int>(c.y());
       const int z = static_cast<int>(c.z());
-      const int key = (z * ny_ + y) * nx_ + x;
-      if (key == last) continue;
-      last = key;
+      const std::int64_t key = z * nxy64 + y * nx64 + x;
+      std::int64_t& slot = recent[static_cast<std::size_t>(key) & (kRecent - 1)];
+      if (slot == key) continue;
+      slot = key;
       update(x, y, z, hit_, stamp, &stats);
     }
   }
