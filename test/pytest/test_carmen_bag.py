@@ -74,3 +74,23 @@ def test_a_malformed_line_is_refused_by_number(tmp_path: Path, line: str) -> Non
 def test_a_log_without_scans_is_refused(tmp_path: Path) -> None:
     with pytest.raises(carmen_bag.CarmenError, match="no FLASER"):
         carmen_bag.read_log(write_log(tmp_path / "empty.log", ["ODOM 0 0 0 0 0 0 1 h 1"]))
+
+
+def test_an_existing_bag_is_kept_unless_overwrite_is_given(tmp_path: Path) -> None:
+    log = write_log(tmp_path / "a.log", [flaser([1.0, 2.0], (0.0, 0.0, 0.0), 10.0)])
+    bag = tmp_path / "a.bag"
+    bag.write_bytes(b"precious")
+    with pytest.raises(SystemExit, match="exists; pass --overwrite"):
+        carmen_bag.main([str(log), str(bag)])
+    assert bag.read_bytes() == b"precious"
+    carmen_bag.main([str(log), str(bag), "--overwrite"])
+    with rosbag.Bag(str(bag)) as b:
+        assert b.get_message_count("/scan") == 1
+    # Never through a symlink or onto something that is not a regular file.
+    link = tmp_path / "link.bag"
+    link.symlink_to(tmp_path / "elsewhere.bag")
+    with pytest.raises(SystemExit, match="not a regular file"):
+        carmen_bag.main([str(log), str(link), "--overwrite"])
+    assert not (tmp_path / "elsewhere.bag").exists()
+    with pytest.raises(SystemExit, match="not a regular file"):
+        carmen_bag.main([str(log), str(tmp_path), "--overwrite"])

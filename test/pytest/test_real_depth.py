@@ -92,6 +92,8 @@ def test_depth_bag_replays_through_the_tsdf_nodelet(tmp_path: Path) -> None:
     tool = "downstream_perception.ros.depth_bag"
     cmd = [sys.executable, "-m", tool, str(DATA / "depth_mm.npz"), str(DATA / "trajectory.log")]
     subprocess.run([*cmd, str(bag)], check=True, capture_output=True, timeout=60)
+    again = subprocess.run([*cmd, str(bag)], capture_output=True, text=True, timeout=60)
+    assert again.returncode == 1 and "--overwrite" in again.stderr  # an existing bag is kept
     config = Path(__file__).resolve().parents[2] / "cfg" / "tsdf.yaml"
     out = tmp_path / "out"
     replay = [sys.executable, "-m", "downstream_perception.replay", str(bag), "--quiet"]

@@ -112,7 +112,11 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("log", type=Path)
     ap.add_argument("bag", type=Path)
+    ap.add_argument("--overwrite", action="store_true", help="replace an existing bag")
     args = ap.parse_args(argv)
+    from downstream_perception.ros.util import refuse_existing_output
+
+    refuse_existing_output(args.bag, args.overwrite, "carmen_bag")
     scans, offset = read_log(args.log)
     n = write_bag(scans, offset, args.bag)
     span = scans[-1].stamp_s - scans[0].stamp_s

@@ -23,7 +23,7 @@ import rospy
 from sensor_msgs.msg import CameraInfo, Image
 from tf2_msgs.msg import TFMessage
 
-from downstream_perception.ros.util import transform_from_matrix
+from downstream_perception.ros.util import refuse_existing_output, transform_from_matrix
 from downstream_perception.trajectory_log import read_trajectory_log
 
 START_S = 100.0
@@ -67,12 +67,14 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("depth", type=Path, help=".npz with depth_mm (frames, h, w) uint16")
     ap.add_argument("trajectory", type=Path, help="Open3D / Redwood trajectory .log")
     ap.add_argument("bag", type=Path)
+    ap.add_argument("--overwrite", action="store_true", help="replace an existing bag")
     ap.add_argument("--fx", type=float, default=525.0, help="px (PrimeSense default)")
     ap.add_argument("--fy", type=float, default=525.0, help="px")
     ap.add_argument("--cx", type=float, default=319.5, help="px")
     ap.add_argument("--cy", type=float, default=239.5, help="px")
     ap.add_argument("--rate-hz", type=float, default=5.0, help="frame rate of the stamps")
     args = ap.parse_args(argv)
+    refuse_existing_output(args.bag, args.overwrite, "depth_bag")
     with np.load(args.depth) as data:
         depth = data["depth_mm"]
     poses = read_trajectory_log(args.trajectory)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -139,3 +140,13 @@ def wait_until(predicate: Callable[[], bool], timeout_s: float = 15.0) -> bool:
             return True
         time.sleep(0.1)
     return bool(predicate())
+
+
+def refuse_existing_output(path: Path, overwrite: bool, tool: str) -> None:
+    """Exits (status 1, the reason on stderr) when `path` exists and `overwrite` is not given, or
+    when it is not a regular file (a directory, a device, a dangling or live symlink): a
+    converter never replaces a file it was not asked to replace."""
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise SystemExit(f"{tool}: {path} is not a regular file; refusing to write it")
+    if path.exists() and not overwrite:
+        raise SystemExit(f"{tool}: {path} exists; pass --overwrite to replace it")
