@@ -67,7 +67,7 @@ bench-open3d: build
 		"$$WS/open3d-venv/bin/python" bench/bench_open3d.py
 
 # TSDF mesh accuracy over scenes, lattice offsets and noise cases, ours next to Open3D 0.19
-# (same venv as bench-open3d); every score in out/tsdf_accuracy.json. About an hour on one core.
+# (same venv as bench-open3d); every score in out/tsdf_accuracy.json. About 28 minutes on one core.
 bench-tsdf-accuracy: build
 	@tools/open3d_venv.sh
 	@source tools/env.sh && source_workspace && OMP_NUM_THREADS=1 \
