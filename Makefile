@@ -13,7 +13,7 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build install-check pip-check test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d soak lint clean
+.PHONY: help deps build install-check pip-check test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d bench-tsdf-accuracy soak lint clean
 
 FUZZ_CASES ?= 20000
 FUZZ_SEED ?= 17
@@ -21,7 +21,7 @@ SOAK_MINUTES ?= 10
 SOAK_ONLY ?=
 
 help:
-	@echo "make demo | make test | make install-check | make pip-check | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make soak | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make install-check | make pip-check | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make bench-tsdf-accuracy | make soak | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -65,6 +65,13 @@ bench-open3d: build
 	@tools/open3d_venv.sh
 	@source tools/env.sh && source_workspace && OMP_NUM_THREADS=1 \
 		"$$WS/open3d-venv/bin/python" bench/bench_open3d.py
+
+# TSDF mesh accuracy over scenes, lattice offsets and noise cases, ours next to Open3D 0.19
+# (same venv as bench-open3d); every score in out/tsdf_accuracy.json. About 28 minutes on one core.
+bench-tsdf-accuracy: build
+	@tools/open3d_venv.sh
+	@source tools/env.sh && source_workspace && OMP_NUM_THREADS=1 \
+		"$$WS/open3d-venv/bin/python" bench/bench_tsdf_accuracy.py --json out/tsdf_accuracy.json
 
 soak: build
 	@source tools/env.sh && source_workspace && python3 bench/soak.py --out out \

@@ -63,16 +63,49 @@ def observed_samples(
     return samples[seen]
 
 
-def sample_triangles(vertices: np.ndarray, triangles: np.ndarray, spacing_m: float) -> np.ndarray:
-    """Points on the triangles at most about `spacing_m` apart (barycentric grid per triangle)."""
+def sample_triangles(
+    vertices: np.ndarray, triangles: np.ndarray, spacing_m: float, longest_m: float | None = None
+) -> np.ndarray:
+    """Points on the triangles at most about `spacing_m` apart (barycentric grid per triangle,
+    as fine as the longest edge, `longest_m` if given, needs)."""
     tri = vertices[triangles].astype(float)  # (T, 3, 3)
-    longest = np.max(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2))
-    n = max(1, int(np.ceil(longest / spacing_m)))
+    if longest_m is None:
+        longest_m = longest_edge(vertices, triangles)
+    n = max(1, int(np.ceil(longest_m / spacing_m)))
     i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
     keep = i + j <= n
     a, b = i[keep] / n, j[keep] / n
     weights = np.stack([1 - a - b, a, b], 1)  # (K, 3)
     return np.einsum("kc,tcd->tkd", weights, tri).reshape(-1, 3)
+
+
+def longest_edge(vertices: np.ndarray, triangles: np.ndarray) -> float:
+    tri = vertices[triangles].astype(float)
+    return float(np.max(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)))
+
+
+def near_mesh(
+    points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray, radius_m: float
+) -> np.ndarray:
+    """Whether each point lies within `radius_m` of the mesh's surface sampled every radius / 4
+    (sample_triangles). A point with a vertex that near is (vertices are samples); the others
+    are checked against the samples of the triangles that could hold one that near (those with a
+    vertex within radius + the longest edge: every point of a triangle lies within its longest
+    edge of each of its vertices). Same answer as sampling every triangle, several times faster."""
+    distance, _ = cKDTree(vertices).query(points, distance_upper_bound=radius_m)
+    near = np.isfinite(distance)
+    rest = np.flatnonzero(~near)
+    if len(rest) == 0 or len(triangles) == 0:
+        return near
+    longest = longest_edge(vertices, triangles)
+    reach, _ = cKDTree(points[rest]).query(vertices, distance_upper_bound=radius_m + longest + 1e-9)
+    candidates = triangles[np.isfinite(reach)[triangles].any(axis=1)]
+    if len(candidates) == 0:
+        return near
+    surface = sample_triangles(vertices, candidates, 0.25 * radius_m, longest)
+    distance, _ = cKDTree(surface).query(points[rest], distance_upper_bound=radius_m)
+    near[rest] = np.isfinite(distance)
+    return near
 
 
 def score_mesh(
@@ -86,13 +119,12 @@ def score_mesh(
     if len(vertices) == 0:
         return MeshScore(0, 0, np.inf, np.inf, 1.0, 0.0)
     error = np.abs(scene.signed_distance(vertices.astype(float)))
-    surface = sample_triangles(vertices, triangles, 0.25 * completeness_radius_m)
-    distance, _ = cKDTree(surface).query(observed, distance_upper_bound=completeness_radius_m)
+    near = near_mesh(observed, vertices, triangles, completeness_radius_m)
     return MeshScore(
         vertices=len(vertices),
         triangles=len(triangles),
         mean_error_m=float(error.mean()),
         p95_error_m=float(np.percentile(error, 95)),
         ghost_fraction=float((error > voxel_size_m).mean()),
-        completeness=float(np.isfinite(distance).mean()) if len(observed) else 0.0,
+        completeness=float(near.mean()) if len(observed) else 0.0,
     )

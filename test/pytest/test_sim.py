@@ -22,9 +22,11 @@ from downstream_perception.sim import world as w
 from downstream_perception.sim.depth_camera import (
     CORRIDOR_PERIOD_M,
     DepthCamera,
+    box_signed_distance,
     corridor_poses,
     corridor_scene,
 )
+from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
 
 
 def cast(world: World, origin: tuple[float, float], angle_deg: float, t: float = 0.0) -> float:
@@ -199,3 +201,55 @@ def test_corridor_poses_walk_ahead_one_period() -> None:
         np.testing.assert_allclose(T[:3, :3].T @ T[:3, :3], np.eye(3), atol=1e-12)
     with pytest.raises(ValueError):
         corridor_poses(0)
+
+
+@pytest.mark.parametrize("name", list(ACCURACY_SCENES))
+def test_accuracy_scenes_are_seen_from_free_space_and_render_their_surfaces(name: str) -> None:
+    cam = small_camera()
+    scene, poses = accuracy_scene(name, frames=8)
+    assert len(poses) == 8
+    rays = cam.rays()
+    for T in poses:
+        assert scene.signed_distance(T[None, :3, 3])[0] > 0.3  # cameras stand in free space
+        depth = cam.render(scene, T).ravel()
+        hit = np.isfinite(depth)
+        assert hit.mean() > 0.99  # closed scenes: every ray hits within 10 m
+        points = (rays[hit] * depth[hit, None]) @ T[:3, :3].T + T[:3, 3]
+        # The ray caster and the signed distance agree: hits lie on the surface.
+        np.testing.assert_allclose(scene.signed_distance(points), 0.0, atol=1e-5)
+    # Every object is seen: some frame's hits lie on it.
+    hits = np.vstack(
+        [(rays * cam.render(scene, T).ravel()[:, None]) @ T[:3, :3].T + T[:3, 3] for T in poses]
+    )
+    hits = hits[np.isfinite(hits).all(axis=1)]
+    objects = [
+        *(box_signed_distance(hits, b) for b in scene.boxes),
+        *(np.linalg.norm(hits - np.asarray(s.center), axis=1) - s.radius for s in scene.spheres),
+        *(
+            np.linalg.norm(hits[:, :2] - np.asarray(c.center_xy), axis=1) - c.radius
+            for c in scene.cylinders
+        ),
+    ]
+    assert len(objects) >= 4
+    for distance in objects:
+        assert np.sum(np.abs(distance) < 1e-4) > 0
+
+
+@pytest.mark.parametrize("name", list(ACCURACY_SCENES))
+def test_accuracy_scene_offsets_move_scene_and_cameras_together(name: str) -> None:
+    cam = small_camera()
+    offset = (0.005, 0.0125, 0.0375)
+    base, base_poses = accuracy_scene(name, frames=4)
+    moved, moved_poses = accuracy_scene(name, offset, frames=4)
+    for T, M in zip(base_poses, moved_poses, strict=True):
+        np.testing.assert_allclose(M[:3, 3] - T[:3, 3], offset, atol=1e-12)
+        np.testing.assert_array_equal(M[:3, :3], T[:3, :3])
+        # Same images: only the lattice moves under them.
+        np.testing.assert_allclose(cam.render(moved, M), cam.render(base, T), atol=1e-5)
+    points = np.random.default_rng(0).uniform(-1.5, 1.5, (500, 3)) + [0.0, 0.0, 1.5]
+    np.testing.assert_allclose(
+        moved.signed_distance(points + offset), base.signed_distance(points), atol=1e-12
+    )
+    # Offset 0 is the aligned case: the walls lie on multiples of 2 cm and 5 cm.
+    walls = np.array([*base.room_min, *base.room_max])
+    np.testing.assert_allclose(np.round(walls / 0.1) * 0.1, walls, atol=1e-12)

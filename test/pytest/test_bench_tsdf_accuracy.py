@@ -1,0 +1,105 @@
+"""The accuracy benchmark's scoring and bookkeeping (bench/bench_tsdf_accuracy.py), on ours only:
+Open3D is not installed for the tests."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[2] / "bench" / "bench_tsdf_accuracy.py"
+
+
+@pytest.fixture(scope="module")
+def bench() -> Any:
+    spec = importlib.util.spec_from_file_location("bench_tsdf_accuracy", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def room(bench: Any) -> tuple:
+    """The room at a quarter of 320x240 (same field of view), 10 frames, a quarter-voxel offset
+    at 5 cm, and its observed surface."""
+    from downstream_perception.sim.depth_camera import DepthCamera
+    from downstream_perception.sim.scenes import accuracy_scene
+    from downstream_perception.tsdf_eval import observed_samples
+
+    cam = bench.scaled(DepthCamera(), 0.5)
+    assert (cam.width, cam.height, cam.fx) == (160, 120, 131.25)
+    scene, poses = accuracy_scene("room", (0.0125,) * 3, frames=10)
+    depths = [cam.render(scene, T) for T in poses]
+    return cam, scene, poses, depths, observed_samples(scene, cam, poses, depths)
+
+
+def test_ours_is_scored_and_pose_errors_show(bench: Any, room: tuple) -> None:
+    cam, scene, poses, depths, observed = room
+    clean = bench.score_case(bench.ours(), scene, cam, depths, poses, 0.05, observed)
+    assert clean["vertices"] > 1000
+    assert clean["mean_mm"] < 4.0
+    assert clean["ghost_pct"] < 2.0
+    assert clean["completeness"] > 0.9
+    # Integrated at poses 10 cm off along x (two voxels): the mesh is off the true surfaces.
+    off = [T.copy() for T in poses]
+    for T in off:
+        T[0, 3] += 0.1
+    shifted = bench.score_case(bench.ours(), scene, cam, depths, off, 0.05, observed)
+    assert shifted["mean_mm"] > 3 * clean["mean_mm"]
+    assert shifted["ghost_pct"] > 10 * clean["ghost_pct"]
+    # The noise cases are seeded: the same frames for every integrator.
+    noise = bench.NOISES[3]
+    d1, p1 = bench.noisy_frames(depths, poses, noise, seed=7)
+    d2, p2 = bench.noisy_frames(depths, poses, noise, seed=7)
+    np.testing.assert_array_equal(d1[0], d2[0])
+    np.testing.assert_array_equal(p1[0], p2[0])
+    assert 0.002 < np.nanstd(d1[0] - depths[0]) < 0.008
+    assert np.abs(p1[0][:3, 3] - poses[0][:3, 3]).max() > 1e-4
+
+
+def test_weld_merges_repeated_vertices(bench: Any) -> None:
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float)
+    triangles = np.array([[0, 1, 2], [3, 5, 4]])
+    welded, remapped = bench.weld(vertices, triangles)
+    assert len(welded) == 4
+    np.testing.assert_array_equal(welded[remapped], vertices[triangles])
+
+
+def test_summary_gives_median_and_range_over_scenes_and_offsets(bench: Any) -> None:
+    def score(scene: str, offset: float, mean_mm: float, integrator: str = "ours") -> Any:
+        return bench.Score("320x240", 0.05, "clean", integrator, scene, offset, 10, mean_mm,
+                           2 * mean_mm, 0.1 * mean_mm, 1.0 - 0.01 * mean_mm)  # fmt: skip
+
+    scores = [score("a", 0.0, 1.0), score("a", 0.5, 4.0), score("b", 0.0, 2.0)]
+    scores.append(score("a", 0.0, 9.0, "other"))
+    summary = bench.summarise(scores)
+    ours = summary[("320x240", 0.05, "clean", "ours")]
+    assert ours["cases"] == 3
+    assert ours["mean_mm"] == (1.0, 2.0, 4.0)
+    assert ours["completeness"] == pytest.approx((0.96, 0.98, 0.99))
+    assert summary[("320x240", 0.05, "clean", "other")]["mean_mm"] == (9.0, 9.0, 9.0)
+    table = "\n".join(bench.markdown(summary, "t"))
+    assert "| 320x240, 5 cm | clean | ours | 3 | 2.00 (1.00–4.00) | 4.0 (2.0–8.0) |" in table
+
+
+def test_near_mesh_matches_sampling_every_triangle(bench: Any, room: tuple) -> None:
+    # score_mesh's completeness checks vertices first and samples only the triangles that could
+    # matter: the same answer as sampling the whole mesh.
+    from scipy.spatial import cKDTree
+
+    from downstream_perception.tsdf_eval import near_mesh, sample_triangles
+
+    cam, scene, poses, depths, observed = room
+    noisy_depths, noisy_poses = bench.noisy_frames(depths, poses, bench.NOISES[3], seed=3)
+    vertices, triangles = bench.weld(*bench.ours()(noisy_depths, noisy_poses, cam, 0.05))
+    near = near_mesh(observed, vertices, triangles, 0.02)
+    surface = sample_triangles(vertices, triangles, 0.005)
+    distance, _ = cKDTree(surface).query(observed, distance_upper_bound=0.02)
+    np.testing.assert_array_equal(near, np.isfinite(distance))
+    assert 0.3 < near.mean() < 0.99  # both kinds of answer occur
