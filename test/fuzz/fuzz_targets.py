@@ -1878,7 +1878,9 @@ def gen_voxel_map(rng: np.random.Generator) -> dict[str, Any]:
             columns = rng.integers(-5, 125, size=(n, 2))
             if g.chance(0.1):
                 columns = np.array([[2**62, -(2**62)], [2**31, 0]] * (n // 2 + 1))
-            ops.append((op, columns if g.chance(0.9) else g.array((n, 3), -5, 125), g.f(0, 10, 0.1)))
+            ops.append(
+                (op, columns if g.chance(0.9) else g.array((n, 3), -5, 125), g.f(0, 10, 0.1))
+            )
         elif op == "window":
             ops.append(
                 (op, *(g.i(-50, 50, 0.1, INT32_NASTY) for _ in range(2)))
