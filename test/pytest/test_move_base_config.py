@@ -48,15 +48,55 @@ PAIRS = {
         "",
         "move_base_launch_params.yaml",
     ),
+    "mir": (
+        "costmap_common_params.yaml",
+        "costmap_global_params.yaml",
+        "costmap_local_params.yaml",
+        "",
+        "",
+        "move_base_launch_params.yaml",
+    ),
+}
+# root, global_more, local_more: files loaded besides the pair (real_configs.launch's args).
+MORE = {
+    "mir": (
+        "move_base_common_params.yaml",
+        "costmap_global_params_plugins_no_virtual_walls.yaml",
+        "costmap_local_params_plugins_no_virtual_walls.yaml",
+    ),
 }
 
 
 def tree_of(robot: str) -> mbc.Params:
     common, glob, local, gns, lns, extra = PAIRS[robot]
     d = CONFIGS / robot
+    root, gmore, lmore = (str(d / f) if f else "" for f in MORE.get(robot, ("", "", "")))
     return mbc.load_pair(
-        str(d / common), str(d / glob), str(d / local), gns, lns, str(d / extra) if extra else ""
+        str(d / common),
+        str(d / glob),
+        str(d / local),
+        gns,
+        lns,
+        str(d / extra) if extra else "",
+        root,
+        gmore,
+        lmore,
     )
+
+
+def test_root_and_more_files_like_mir_launch() -> None:
+    """MiR: the plugins lists come from the *_more files, the footprint from move_base's own file
+    at the root (searchParam), and each costmap keeps its own ranges and voxel columns."""
+    glob, local = mbc.costmaps_of(tree_of("mir"))
+    assert [layer.name for layer in glob.layers] == ["navigation_map", "obstacles", "inflation"]
+    assert [layer.name for layer in local.layers] == ["obstacles", "inflation"]
+    assert glob.footprint() == local.footprint()
+    assert glob.footprint()[0] == (0.488, -0.293)
+    assert (glob.robot_base_frame, local.global_frame) == ("base_footprint", "odom")
+    assert {s.raytrace_range for s in glob.sources()} == {2.0}
+    assert {s.raytrace_range for s in local.sources()} == {6.0}
+    assert {s.obstacle_range for s in local.sources()} == {3.0}
+    assert [s.marking for s in local.sources()] == [True, False, True, False]
 
 
 def test_merge_unrolls_dictionaries_like_roslaunch() -> None:

@@ -100,6 +100,9 @@ def load_pair_from(get: Any, ns: str = "/real_config") -> Params:
         get(f"{ns}/global_ns", ""),
         get(f"{ns}/local_ns", ""),
         get(f"{ns}/extra", ""),
+        get(f"{ns}/root", ""),
+        get(f"{ns}/global_more", ""),
+        get(f"{ns}/local_more", ""),
     )
 
 
@@ -110,20 +113,31 @@ def load_pair(
     global_ns: str = "",
     local_ns: str = "",
     extra: str = "",
+    root: str = "",
+    global_more: str = "",
+    local_more: str = "",
 ) -> Params:
-    """The parameter tree move_base's launch files build: the common file into global_costmap and
-    local_costmap, then the global and local files into global_ns / local_ns ("" when the file
-    starts with its own `global_costmap:` / `local_costmap:` key), then `extra` at the root."""
+    """The parameter tree move_base's launch files build: `root` (move_base's own file, e.g. the
+    footprint) at the root, the common file into global_costmap and local_costmap, then the global
+    and local files (each followed by its optional `*_more` file, e.g. a plugins list) into
+    global_ns / local_ns ("" when the file starts with its own `global_costmap:` /
+    `local_costmap:` key), then `extra` at the root."""
     tree: Params = {}
 
     def read(path: str) -> Params:
         with open(path, encoding="utf-8") as f:
             return yaml.safe_load(f) or {}
 
+    if root:
+        merge(tree, "", read(root))
     merge(tree, "global_costmap", read(common))
     merge(tree, "local_costmap", read(common))
     merge(tree, global_ns, read(global_file))
+    if global_more:
+        merge(tree, global_ns, read(global_more))
     merge(tree, local_ns, read(local_file))
+    if local_more:
+        merge(tree, local_ns, read(local_more))
     if extra:
         merge(tree, "", read(extra))
     return tree
