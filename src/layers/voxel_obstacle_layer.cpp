@@ -188,6 +188,13 @@ void VoxelObstacleLayer::onInitialize() {
 void VoxelObstacleLayer::matchSize() {
   const GridGeometry& g = layered_costmap_->costmap().geometry();
   std::lock_guard<std::mutex> lock(mutex_);
+  if (g.sizeX() <= 0 || g.sizeY() <= 0) {
+    // Not sized yet (costmap_2d initialises its layers before it sizes the master): no map and
+    // no error until the master has cells.
+    map_.reset();
+    config_errors_.clear("window");
+    return;
+  }
   config_.resolution_m = g.resolution();
   try {
     auto map = std::make_unique<VoxelMap>(config_, g.latticeAnchorX(), g.latticeAnchorY(),
@@ -266,6 +273,8 @@ void VoxelObstacleLayer::updateBounds(double robot_x, double robot_y, double rob
   }
   if (!map_ || !enabled_) return;
   const ros::Time now = ros::Time::now();
+  // Every update cycle, as costmap_2d's VoxelLayer publishes its grid (rate-limited here).
+  if (publish_voxel_map_) publishVoxels(now);
   if (footprint_clearing_enabled_ && layered_costmap_->hasRobotPose()) {
     clearFootprint(robot_x, robot_y, robot_yaw, now);
   }
@@ -311,7 +320,6 @@ void VoxelObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, int 
       }
     }
   }
-  if (publish_voxel_map_) publishVoxels(now);
 }
 
 void VoxelObstacleLayer::publishVoxels(const ros::Time& stamp) {
@@ -349,7 +357,7 @@ void VoxelObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
                std::to_string(map_->bandFirst()) + " .. " + std::to_string(map_->bandLast()));
   }
   status.add("updates dropped by the memory bound", dropped_updates_);
-  status.add("lethal columns (last update)", lethal_columns_);
+  status.add("lethal columns (last update's window)", lethal_columns_);
   status.add("footprint clearing", footprint_clearing_enabled_);
   status.add("voxels cleared under the footprint", footprint_voxels_cleared_);
   std::string stale;
