@@ -299,7 +299,8 @@ void VoxelObstacleLayer::updateCosts(Costmap& master, int min_i, int min_j, int 
   std::lock_guard<std::mutex> lock(mutex_);
   if (!map_ || !enabled_) return;
   const ros::Time now = ros::Time::now();
-  map_->project(now.toSec(), &projection_);
+  // Only the update's bounds (a global costmap's window can hold millions of columns).
+  map_->project(now.toSec(), CellBounds{min_i, min_j, max_i - 1, max_j - 1}, &projection_);
   redraw_all_ = false;
   dirty_ = CellBounds();
   const GridGeometry& g = master.geometry();

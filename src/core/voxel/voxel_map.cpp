@@ -473,11 +473,21 @@ std::uint8_t VoxelMap::columnCost(const VoxelColumn& c) const {
 
 void VoxelMap::project(double now_s, std::vector<std::uint8_t>* costs) const {
   costs->assign(static_cast<std::size_t>(nx_) * ny_, 0);
+  project(now_s, CellBounds{0, 0, nx_ - 1, ny_ - 1}, costs);
+}
+
+void VoxelMap::project(double now_s, const CellBounds& window,
+                       std::vector<std::uint8_t>* costs) const {
+  const std::size_t cells = static_cast<std::size_t>(nx_) * ny_;
+  if (costs->size() != cells) costs->assign(cells, 0);
+  if (window.empty()) return;
+  const int x0 = std::max(0, window.min_x), x1 = std::min(nx_ - 1, window.max_x);
+  const int y0 = std::max(0, window.min_y), y1 = std::min(ny_ - 1, window.max_y);
   const int band = band_last_ - band_first_ + 1;
   const VoxelColumn unseen{0, band};
   const std::uint8_t unseen_cost = columnCost(unseen);
-  for (int y = 0; y < ny_; ++y) {
-    for (int x = 0; x < nx_; ++x) {
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
       // Most columns have no block at all in the band: one or two null pointers decide them.
       bool any = false;
       for (int bz = band_first_ >> VoxelBlock::kEdgeShift;

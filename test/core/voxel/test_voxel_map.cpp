@@ -485,3 +485,32 @@ TEST(VoxelMap, HeightBandDropsPointsOutsideItOnly) {
   EXPECT_TRUE(std::isnan(pts[5]));
   EXPECT_FLOAT_EQ(pts[6], 5.0f);
 }
+
+TEST(VoxelMap, WindowProjectionMatchesTheFullOneInsideAndLeavesTheRest) {
+  VoxelMap map(roomConfig(), 0.0, 0.0, 40, 40);
+  std::vector<float> pts;
+  for (int k = 0; k < 40; ++k) add(&pts, 3.05, 0.05 + 0.1 * k, 0.55);  // a wall at x 3.05 m
+  integrate(&map, Eigen::Vector3d(0.55, 2.05, 0.55), pts, 0.0);
+  std::vector<std::uint8_t> full;
+  map.project(0.0, &full);
+  std::vector<std::uint8_t> part(40 * 40, 7);  // 7: no cost value, must survive outside
+  map.project(0.0, CellBounds{25, 10, 34, 29}, &part);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * 40 + x;
+      const bool inside = x >= 25 && x <= 34 && y >= 10 && y <= 29;
+      EXPECT_EQ(part[i], inside ? full[i] : 7) << x << ", " << y;
+    }
+  }
+  EXPECT_EQ(part[20 * 40 + 30], kLethalObstacle);  // the wall's column in the window
+  // A window partly outside is clipped; an empty one changes nothing; a wrong size is resized.
+  map.project(0.0, CellBounds{-5, -5, 2, 2}, &part);
+  EXPECT_EQ(part[0], full[0]);
+  const std::vector<std::uint8_t> before = part;
+  map.project(0.0, CellBounds{}, &part);
+  EXPECT_EQ(part, before);
+  std::vector<std::uint8_t> small(3, 1);
+  map.project(0.0, CellBounds{0, 0, 0, 0}, &small);
+  ASSERT_EQ(small.size(), 1600u);
+  EXPECT_EQ(small[0], full[0]);
+}

@@ -140,6 +140,10 @@ class VoxelMap {
   static constexpr int kCostmap2dColumnBits = 16;
   /// Costs of all window columns, row-major (index = y * nx + x), into *costs (resized).
   void project(double now_s, std::vector<std::uint8_t>* costs) const;
+  /// The same for the columns inside `window` (window-relative, clipped) only: *costs is resized
+  /// to nx * ny (zeros) if it has another size, and its cells outside the window are left as they
+  /// are. What a costmap update needs: its bounds, not the whole window.
+  void project(double now_s, const CellBounds& window, std::vector<std::uint8_t>* costs) const;
   /// Band voxel layers [first, last] (inclusive z indices whose centre is in the height band).
   int bandFirst() const { return band_first_; }
   int bandLast() const { return band_last_; }
