@@ -10,6 +10,7 @@
 
 #include "downstream_perception/core/voxel/depth_rays.h"
 #include "downstream_perception/core/voxel/scan_rays.h"
+#include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
 #include "downstream_perception/ros/costmap/layered_costmap.h"
 
@@ -30,36 +31,28 @@ bool VoxelObstacleLayer::lookup(Source* s, const std::string& frame, const ros::
     reject(s, "zero stamp: a message must carry its measurement time");
     return false;
   }
-  try {
-    const auto t = tf_->lookupTransform(layered_costmap_->globalFrame(), frame, stamp);
-    const auto& q = t.transform.rotation;
-    const auto& v = t.transform.translation;
-    *pose = Eigen::Isometry3d::Identity();
-    pose->linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
-    pose->translation() = Eigen::Vector3d(v.x, v.y, v.z);
-    if (!pose->matrix().allFinite()) {  // a zero or NaN quaternion normalises to NaN
-      reject(s, "transform from '" + frame + "' is not finite");
-      return false;
-    }
-    return true;
-  } catch (const tf2::TransformException& e) {
-    reject(s, std::string("tf: ") + e.what());
-    return false;
-  }
+  std::string why;
+  if (transformAt(frame, stamp, pose, &why)) return true;
+  reject(s, why);
+  return false;
 }
 
 bool VoxelObstacleLayer::lookupQuiet(const std::string& frame, const ros::Time& stamp,
                                      Eigen::Isometry3d* pose) {
+  return transformAt(frame, stamp, pose, nullptr);
+}
+
+bool VoxelObstacleLayer::transformAt(const std::string& frame, const ros::Time& stamp,
+                                     Eigen::Isometry3d* pose, std::string* why) {
   try {
-    const auto t = tf_->lookupTransform(layered_costmap_->globalFrame(), frame, stamp);
-    const auto& q = t.transform.rotation;
-    const auto& v = t.transform.translation;
-    pose->linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
-    pose->translation() = Eigen::Vector3d(v.x, v.y, v.z);
-    return pose->matrix().allFinite();
-  } catch (const tf2::TransformException&) {
+    *pose = toEigen(tf_->lookupTransform(layered_costmap_->globalFrame(), frame, stamp).transform);
+  } catch (const tf2::TransformException& e) {
+    if (why) *why = std::string("tf: ") + e.what();
     return false;
   }
+  if (pose->matrix().allFinite()) return true;  // a zero or NaN quaternion normalises to NaN
+  if (why) *why = "transform from '" + frame + "' is not finite";
+  return false;
 }
 
 void VoxelObstacleLayer::onCameraInfo(Source* s, const sensor_msgs::CameraInfoConstPtr& msg) {

@@ -108,6 +108,10 @@ class VoxelObstacleLayer : public Layer {
   bool lookup(Source* s, const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
   /// The same without a rejection: false if tf cannot give a finite transform.
   bool lookupQuiet(const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose);
+  /// global <- frame at `stamp` through tf; false with the reason in *why (if given) when tf
+  /// has none or it is not finite.
+  bool transformAt(const std::string& frame, const ros::Time& stamp, Eigen::Isometry3d* pose,
+                   std::string* why);
   /// Drops the hits outside the source's height band, then integrates (hits is modified).
   void integrate(Source* s, const Eigen::Vector3d& origin, std::vector<float>& hits,
                  const std::vector<float>& no_returns, const ros::Time& stamp);
