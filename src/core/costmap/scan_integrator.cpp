@@ -189,7 +189,7 @@ void ScanIntegrator::beamsFromMovingScan(const LaserScanView& scan, const Pose2D
 
 IntegrationStats ScanIntegrator::integrate(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
                                            const IntegrationStats& decisions) {
-  IntegrationStats stats = integrateBeams(grid, beams, &integration_scratch_, walk_);
+  IntegrationStats stats = integrateBeams(grid, beams, &integration_scratch_, walk_, threads_);
   stats.beams = decisions.beams;
   stats.beams_invalid = decisions.beams_invalid;
   stats.beams_no_return = decisions.beams_no_return;

@@ -95,9 +95,13 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
   LogOddsGrid blocks(g, model);
   LogOddsGrid per_ray(g, model);
   LogOddsGrid automatic(g, model);
+  LogOddsGrid threaded(g, model);
+  LogOddsGrid threaded_per_ray(g, model);
   std::vector<int> oracle(g.cellCount(), 0);
   IntegrationScratch scratch;  // reused across scans, as the integrator does
   IntegrationScratch auto_scratch;
+  IntegrationScratch threaded_scratch;
+  IntegrationScratch threaded_per_ray_scratch;
   const double w = g.sizeX() * g.resolution();
   const double h = g.sizeY() * g.resolution();
   std::uniform_real_distribution<double> ux(g.originX() - 0.1 * w, g.originX() + 1.1 * w);
@@ -121,12 +125,22 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     const IntegrationStats a = integrateBeams(blocks, scan, &scratch, ClearingWalk::kBlockSkip);
     const IntegrationStats b = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
     const IntegrationStats c = integrateBeams(automatic, scan, &auto_scratch, ClearingWalk::kAuto);
+    // Two threads from the first ray cell on (the default waits for 100,000).
+    const IntegrationStats d =
+        integrateBeams(threaded, scan, &threaded_scratch, ClearingWalk::kBlockSkip, 2, 0);
+    const IntegrationStats e = integrateBeams(threaded_per_ray, scan, &threaded_per_ray_scratch,
+                                              ClearingWalk::kPerRay, 2, 0);
     oracleIntegrate(g, per_ray, &oracle, scan);
     expectSameStats(a, b);
     expectSameStats(c, b);
+    expectSameStats(d, b);
+    expectSameStats(e, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
+      ASSERT_EQ(threaded.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
+      ASSERT_EQ(threaded_per_ray.rawCells()[i], per_ray.rawCells()[i])
+          << "seed " << seed << " scan " << s;
       ASSERT_EQ(blocks.units(i), oracle[i]) << "seed " << seed << " scan " << s << " cell " << i;
     }
   }
@@ -220,4 +234,97 @@ TEST(ScanClearing, AutoTakesTheBlockWalkOnlyForDenseRaysOverSeenSpace) {
   // Sparse rays (fewer cells than the box): per ray, saturated or not.
   EXPECT_FALSE(autoChoosesBlockWalk(1000, 1000, 1.0));
   EXPECT_FALSE(autoChoosesBlockWalk(10, 1000, 1.0));
+}
+
+TEST(ScanClearing, TwoThreadsSplitTheRaysAtABlockRow) {
+  // A dense scan from the middle of a 200 x 170 grid: rays going up and down, many crossing the
+  // split row; the two-thread walk must really split them (else the comparisons above would
+  // only compare one thread with itself) and still give the one-thread grid.
+  const GridGeometry g(200, 170, 0.05, -5.0, -4.2);
+  std::mt19937 rng(5);
+  LogOddsGrid one(g);
+  LogOddsGrid two(g);
+  IntegrationScratch one_scratch;
+  IntegrationScratch two_scratch;
+  for (int s = 0; s < 8; ++s) {
+    const auto scan = randomScan(&rng, 0.013 + 0.2 * s, -0.31, 3600, 9.0);
+    const IntegrationStats a = integrateBeams(one, scan, &one_scratch, ClearingWalk::kAuto, 1);
+    const IntegrationStats b = integrateBeams(two, scan, &two_scratch, ClearingWalk::kAuto, 2, 0);
+    expectSameStats(a, b);
+    ASSERT_GE(two_scratch.bands.size(), 3u);
+    std::size_t parts = 0;
+    for (std::size_t b = 0; b < two_scratch.bands.size(); ++b) {
+      EXPECT_FALSE(two_scratch.bands[b].rays.empty());
+      if (b > 0) {
+        EXPECT_EQ(two_scratch.bands[b].first_row % 32, 0);  // edges on block boundaries
+      }
+      parts += two_scratch.bands[b].rays.size();
+    }
+    // Split rays appear in several bands: more parts than rays.
+    EXPECT_GT(parts + two_scratch.rays_serial.size(), two_scratch.rays.size());
+    for (std::size_t i = 0; i < g.cellCount(); ++i) ASSERT_EQ(one.rawCells()[i], two.rawCells()[i]);
+  }
+  // Below the threshold (the default, 200,000 cells) one thread walks: no bands are placed.
+  std::mt19937 rng2(6);
+  const auto sparse = randomScan(&rng2, 0.0, 0.0, 100, 9.0);
+  two_scratch.bands.clear();
+  integrateBeams(two, sparse, &two_scratch, ClearingWalk::kAuto, 2);
+  EXPECT_TRUE(two_scratch.bands.empty());
+}
+
+TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
+  // A square room whose outside no ray reaches, from several spots, on and off the lattice: the
+  // wall blocks keep unseen (changeable) cells behind the wall, so the block walk decides per ray
+  // from the block's masks whether it may jump (its cells miss them) or must walk. Every scan,
+  // one thread and two, must match the per-ray walk.
+  const GridGeometry g(230, 190, 0.05, -5.6, -4.7);
+  const double half_x = 4.4;
+  const double half_y = 3.6;
+  LogOddsGrid per_ray(g);
+  LogOddsGrid blocks(g);
+  LogOddsGrid threaded(g);
+  IntegrationScratch block_scratch;
+  IntegrationScratch threaded_scratch;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> spot(-1.5, 1.5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int s = 0; s < 36; ++s) {
+    const double sx = s % 4 == 0 ? 0.0 : spot(rng);
+    const double sy = s % 4 == 0 ? 0.05 * (s % 3) : spot(rng);
+    std::vector<BeamUpdate> scan;
+    for (int k = 0; k < 2400; ++k) {
+      const double a = 2.0 * M_PI * k / 2400.0;
+      const double c = std::cos(a);
+      const double d = std::sin(a);
+      double r = std::min(c != 0.0 ? (c > 0 ? half_x - sx : half_x + sx) / std::abs(c) : 1e9,
+                          d != 0.0 ? (d > 0 ? half_y - sy : half_y + sy) / std::abs(d) : 1e9);
+      r += noise(rng);
+      BeamUpdate b;
+      b.start_x = sx;
+      b.start_y = sy;
+      b.end_x = sx + r * c;
+      b.end_y = sy + r * d;
+      b.hit_x = b.end_x;
+      b.hit_y = b.end_y;
+      b.mark = true;
+      b.clear = true;
+      scan.push_back(b);
+    }
+    const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats b =
+        integrateBeams(blocks, scan, &block_scratch, ClearingWalk::kBlockSkip, 1);
+    const IntegrationStats c =
+        integrateBeams(threaded, scan, &threaded_scratch, ClearingWalk::kBlockSkip, 2, 0);
+    expectSameStats(b, a);
+    expectSameStats(c, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i) {
+      ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+      ASSERT_EQ(threaded.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+    }
+  }
+  // The outside stayed unseen and the walls occupied.
+  EXPECT_EQ(per_ray.state(g.index(1, 1)), CellState::kUnknown);
+  CellIndex wall;
+  ASSERT_TRUE(g.worldToCell(half_x + 0.001, 0.3, &wall));
+  EXPECT_EQ(per_ray.state(g.index(wall.x, wall.y)), CellState::kOccupied);
 }
