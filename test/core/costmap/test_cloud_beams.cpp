@@ -85,7 +85,7 @@ TEST(CloudBeams, RotatedSensorAndIntegration) {
   EXPECT_EQ(grid.state(grid.geometry().index(c.x, c.y)), CellState::kOccupied);
   ASSERT_TRUE(grid.geometry().worldToCell(-0.025, -1.025, &c));
   EXPECT_EQ(grid.state(grid.geometry().index(c.x, c.y)), CellState::kFree);
-  EXPECT_FALSE((CloudBeamsConfig{1.0, 0.5}).validate().empty());
+  EXPECT_FALSE((CloudBeamsConfig{1.0, 0.5, std::nullopt}).validate().empty());
   EXPECT_TRUE(CloudBeamsConfig{}.validate().empty());
 }
 
