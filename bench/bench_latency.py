@@ -3,23 +3,30 @@ published costmap that contains it, and from a detection's stamp to the first pu
 whose tracked-obstacle cells show it, with the real tracker and costmap nodelets
 (bench/bench_latency.launch, bench/bench_latency.yaml: update and publish at 10 Hz).
 
-This process plays the sensors on its own ROS master: scans at 10 Hz, each with a small blip at
+One process plays the sensors on its own ROS master: scans at 10 Hz, each with a small blip at
 one of 8 places (one return marks a cell, the next scan's pass-through clears it), and
 detections at 15 Hz of short-lived objects (a new one every 0.5 s, seen for 0.4 s, each at its
 own place; the obstacle layer marks on one return from a floor of -0.5, as costmap_2d
 marks). Latency = the receive time of the first costmap message (full grid or update) in
 which the blip's or object's cell is LETHAL, minus the message's stamp; for objects both from the
 first detection (what a planner experiences, including the tracker's min_hits confirmation)
-and from the confirming detection.
+and from the confirming detection. The receive times are taken by a probe in a process of its
+own (this file run with --probe), which learns what to watch from the scans and detections it
+receives: in the sensors' process the probe's callbacks waited for the interpreter lock while the
+sensor loops ran, which added up to tens of milliseconds to some latencies.
 
 Used by bench.py; runnable alone in a sourced workspace: python3 bench/bench_latency.py
 """
 
 from __future__ import annotations
 
+import json
 import multiprocessing
 import os
+import signal
 import subprocess
+import sys
+import tempfile
 import threading
 import time
 from typing import Any
@@ -52,9 +59,15 @@ class Probe:
         self.pending: dict[Any, tuple[list[Any], tuple[slice, slice]]] = {}
         self.results: dict[str, list[list[float]]] = {"scan": [], "object": []}
         self.missed = {"scan": 0, "object": 0}
-        rospy.Subscriber("/costmap/costmap", OccupancyGrid, self.on_full, queue_size=5)
         rospy.Subscriber(
-            "/costmap/costmap_updates", OccupancyGridUpdate, self.on_update, queue_size=50
+            "/costmap/costmap", OccupancyGrid, self.on_full, queue_size=5, tcp_nodelay=True
+        )
+        rospy.Subscriber(
+            "/costmap/costmap_updates",
+            OccupancyGridUpdate,
+            self.on_update,
+            queue_size=50,
+            tcp_nodelay=True,
         )
         from diagnostic_msgs.msg import DiagnosticArray
 
@@ -62,6 +75,38 @@ class Probe:
         # last 200 publishes), free of this process's receive path.
         self.host: dict[str, float] = {}
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=20)
+        # What to watch: learnt from the sensors' own messages.
+        from sensor_msgs.msg import LaserScan
+
+        from downstream_perception.msg import DetectedObjectArray
+
+        self.detection_stamps: dict[int, list[Any]] = {}
+        rospy.Subscriber("/bench/scan", LaserScan, self.on_scan, queue_size=10)
+        rospy.Subscriber(
+            "/bench/detections", DetectedObjectArray, self.on_detections, queue_size=10
+        )
+
+    def on_scan(self, msg: Any) -> None:
+        """Watches the blip this scan shows (the one whose bearing returns short of the wall)."""
+        for k, x in enumerate(BLIPS):
+            bearing = np.arctan2(BLIP_Y, x)
+            i = int(round((bearing - msg.angle_min) / msg.angle_increment))
+            if 0 <= i < len(msg.ranges) and msg.ranges[i] < np.hypot(x, BLIP_Y) + 0.05:
+                self.watch(("scan", k), [msg.header.stamp], x, BLIP_Y)
+
+    def on_detections(self, msg: Any) -> None:
+        """Watches each new object from its first detection; from its min_hits-th (3rd) one on,
+        measures from the first and from that confirming detection."""
+        for d in msg.detections:
+            j = int(d.truth_id)
+            stamps = self.detection_stamps.setdefault(j, [])
+            stamps.append(msg.header.stamp)
+            if len(stamps) == 1:
+                self.watch(("object", j), [], d.position.x, d.position.y, half=0)
+            elif len(stamps) == 3:
+                with self.lock:
+                    if ("object", j) in self.pending:
+                        self.pending[("object", j)][0][:] = [stamps[0], stamps[2]]
 
     def on_diagnostics(self, msg: Any) -> None:
         for status in msg.status:
@@ -150,8 +195,6 @@ def measure(duration_s: float) -> dict[str, Any]:
 
     from downstream_perception.msg import DetectedObject, DetectedObjectArray
     from downstream_perception.ros.util import laser_scan, transform_stamped, wait_until
-    from downstream_perception.sim import Lidar, LidarConfig
-    from downstream_perception.sim.world import World, box_segments
 
     rospy.init_node("bench_latency", disable_signals=True)
     static_tf = StaticTransformBroadcaster()
@@ -162,11 +205,69 @@ def measure(duration_s: float) -> dict[str, Any]:
             transform_stamped("odom", "base_link", now, x=-1.0),
         ]
     )
-    probe = Probe()
     scans = rospy.Publisher("/bench/scan", LaserScan, queue_size=5)
     detections = rospy.Publisher("/bench/detections", DetectedObjectArray, queue_size=5)
-    if not wait_until(lambda: scans.get_num_connections() > 0 and probe.grid is not None, 30.0):
-        raise RuntimeError("bench_latency: the costmap never came up")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "probe.json")
+        probe = subprocess.Popen(
+            [sys.executable, os.path.abspath(__file__), "--probe", out, str(duration_s + 60.0)]
+        )
+        try:
+            # The costmap and the probe listen to both streams, the tracker to the detections.
+            if not wait_until(
+                lambda: scans.get_num_connections() >= 2 and detections.get_num_connections() >= 2,
+                30.0,
+            ):
+                raise RuntimeError("bench_latency: the costmap or the probe never came up")
+            time.sleep(2.0)  # the probe's first full costmap
+            play(duration_s, scans, detections, laser_scan, DetectedObject, DetectedObjectArray)
+            time.sleep(1.0)  # the last messages
+            probe.terminate()
+            probe.wait(timeout=30.0)
+        finally:
+            if probe.poll() is None:
+                probe.kill()
+        with open(out) as f:
+            found = json.load(f)
+    rospy.signal_shutdown("bench done")
+
+    def stats(values: list[float]) -> dict[str, float]:
+        a = 1e3 * np.asarray(values) if values else np.array([np.nan])
+        return {
+            "n": float(len(values)),
+            "p50_ms": float(np.percentile(a, 50)),
+            "p99_ms": float(np.percentile(a, 99)),
+            "max_ms": float(a.max()),
+        }
+
+    scan = [r[0] for r in found["results"]["scan"]]
+    first = [r[0] for r in found["results"]["object"]]
+    confirm = [r[1] for r in found["results"]["object"] if len(r) > 1]
+    return {
+        "duration_s": duration_s,
+        "scan": stats(scan),
+        "scan_missed": float(found["missed"]["scan"]),
+        "object_first": stats(first),
+        "object_confirm": stats(confirm),
+        "object_missed": float(found["missed"]["object"]),
+        "host_data_to_publish_ms": found["host"],
+    }
+
+
+def play(
+    duration_s: float,
+    scans: Any,
+    detections: Any,
+    laser_scan: Any,
+    detected_object: Any,
+    detected_object_array: Any,
+) -> None:
+    """Plays scans (10 Hz, one blip each) and detections (15 Hz) for duration_s."""
+    import rospy
+
+    from downstream_perception.sim import Lidar, LidarConfig
+    from downstream_perception.sim.world import World, box_segments
+
     lidar = Lidar(LidarConfig(num_beams=1440, noise_std_m=0.0))
     wall = [[-3.0, 3.5, 13.0, 3.5]]
     worlds = [
@@ -181,40 +282,29 @@ def measure(duration_s: float) -> dict[str, Any]:
         rate = rospy.Rate(SCAN_HZ)
         seq = 0
         while not stop.is_set() and not rospy.is_shutdown():
-            k = seq % len(BLIPS)
-            ranges = lidar.scan(worlds[k], (0.0, 0.0, 0.0))
+            ranges = lidar.scan(worlds[seq % len(BLIPS)], (0.0, 0.0, 0.0))
             stamp = rospy.Time.now()
-            msg = laser_scan(stamp, "base_link", ranges, c.angle_min, c.angle_increment, 0.05, 20.0)
-            probe.watch(("scan", k), [stamp], BLIPS[k], BLIP_Y)
-            scans.publish(msg)
+            scans.publish(
+                laser_scan(stamp, "base_link", ranges, c.angle_min, c.angle_increment, 0.05, 20.0)
+            )
             seq += 1
             rate.sleep()
 
     def detection_loop() -> None:
         rate = rospy.Rate(DETECTION_HZ)
-        stamps: dict[int, list[Any]] = {}
         while not stop.is_set() and not rospy.is_shutdown():
             stamp = rospy.Time.now()
             t = (stamp - t0).to_sec()
-            msg = DetectedObjectArray()
+            msg = detected_object_array()
             msg.header.stamp, msg.header.frame_id = stamp, "base_link"
             j = int(t // OBJECT_PERIOD_S) if t >= 0.0 else -1
             if j >= 0 and t - j * OBJECT_PERIOD_S < OBJECT_LIFE_S:
-                x = OBJECT_SLOTS[j % len(OBJECT_SLOTS)]
-                first = j not in stamps
-                stamps.setdefault(j, []).append(stamp)
-                d = DetectedObject(header=msg.header, kind=DetectedObject.POSITION, score=0.9)
-                d.position.x, d.position.y = x, OBJECT_Y  # base_link = map here
-                d.position_covariance = [1e-4, 0.0, 0.0, 1e-4]
+                d = detected_object(header=msg.header, kind=detected_object.POSITION, score=0.9)
+                d.position.x, d.position.y = OBJECT_SLOTS[j % len(OBJECT_SLOTS)], OBJECT_Y
+                d.position_covariance = [1e-4, 0.0, 0.0, 1e-4]  # base_link = map here
                 d.size_x = d.size_y = 0.3
                 d.truth_id = j
                 msg.detections.append(d)
-                if first:
-                    probe.watch(("object", j), [], x, OBJECT_Y, half=0)
-                if len(stamps[j]) == 3:  # min_hits: the confirming detection
-                    with probe.lock:
-                        if ("object", j) in probe.pending:
-                            probe.pending[("object", j)][0][:] = [stamps[j][0], stamps[j][2]]
             detections.publish(msg)
             rate.sleep()
 
@@ -223,30 +313,25 @@ def measure(duration_s: float) -> dict[str, Any]:
         th.start()
     time.sleep(duration_s)
     stop.set()
-    time.sleep(1.0)
-    rospy.signal_shutdown("bench done")
+    for th in threads:
+        th.join(timeout=2.0)
 
-    def stats(values: list[float]) -> dict[str, float]:
-        a = 1e3 * np.asarray(values) if values else np.array([np.nan])
-        return {
-            "n": float(len(values)),
-            "p50_ms": float(np.percentile(a, 50)),
-            "p99_ms": float(np.percentile(a, 99)),
-            "max_ms": float(a.max()),
-        }
 
-    scan = [r[0] for r in probe.results["scan"]]
-    first = [r[0] for r in probe.results["object"]]
-    confirm = [r[1] for r in probe.results["object"] if len(r) > 1]
-    return {
-        "duration_s": duration_s,
-        "scan": stats(scan),
-        "scan_missed": float(probe.missed["scan"]),
-        "object_first": stats(first),
-        "object_confirm": stats(confirm),
-        "object_missed": float(probe.missed["object"]),
-        "host_data_to_publish_ms": dict(probe.host),
-    }
+def probe_main(out: str, run_s: float) -> None:
+    """--probe: follows the costmap on the master in ROS_MASTER_URI until SIGTERM (at most run_s
+    seconds), then writes what it measured (receive time minus stamp, s) to `out` as JSON."""
+    import rospy
+
+    rospy.init_node("bench_latency_probe", disable_signals=True)
+    probe = Probe()
+    done = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: done.set())  # the sensors' process: play is over
+    done.wait(run_s)
+    with probe.lock:
+        found = {"results": probe.results, "missed": probe.missed, "host": dict(probe.host)}
+    with open(out, "w") as f:
+        json.dump(found, f)
+    rospy.signal_shutdown("probe done")
 
 
 def markdown(runs: list[dict[str, Any]]) -> list[str]:
@@ -295,4 +380,7 @@ def markdown(runs: list[dict[str, Any]]) -> list[str]:
 
 
 if __name__ == "__main__":
-    print("\n".join(markdown([run(), run(update_on_data=True)])))
+    if len(sys.argv) == 4 and sys.argv[1] == "--probe":
+        probe_main(sys.argv[2], float(sys.argv[3]))
+    else:
+        print("\n".join(markdown([run(), run(update_on_data=True)])))
