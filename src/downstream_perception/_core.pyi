@@ -1505,6 +1505,13 @@ class TrackerConfig:
     @max_age_s.setter
     def max_age_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
+    def maximize_matches(self) -> bool:
+        """
+        Image mode: true (member default, SORT) makes as many pairs as the gate allows, then the largest summed IoU; false (image default) the largest summed (IoU - min_iou), as ByteTrack's lapjv with a cost limit, so one good pair is not traded for two poor ones. Metric mode always maximises the pairs.
+        """
+    @maximize_matches.setter
+    def maximize_matches(self, arg0: bool) -> None: ...
+    @property
     def measurement_std(self) -> float:
         """
         Metric: m, position noise of detections without a covariance. Image: box heights (std of each of centre x, centre y, width and height in px per px of box height).
@@ -2286,9 +2293,10 @@ def slice_distance(
 
 def solve_assignment(
     cost: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"],
+    unmatched_pair_cost: typing.SupportsFloat | typing.SupportsIndex = ...,
 ) -> list[int]:
     """
-    Min-cost assignment of rows to columns; inf = forbidden. Returns the column per row or -1.
+    Min-cost assignment of rows to columns; inf = forbidden. Returns the column per row or -1. unmatched_pair_cost inf (default): as many pairs as possible, then the least total cost; finite L: the least sum of (cost - L), pairs costing L or more never taken (lap.lapjv with cost_limit L, as ByteTrack calls it).
     """
 
 def static_map_values(

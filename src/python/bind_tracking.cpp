@@ -183,9 +183,15 @@ void bindTracking(py::module& m) {
   m.def("chi_square_quantile", &chiSquareQuantile, py::arg("dof"), py::arg("confidence"),
         "Squared-Mahalanobis gate: chi-square quantile (2, 0.99) -> 9.21.");
   m.def(
-      "solve_assignment", [](const Eigen::MatrixXd& cost) { return solveAssignment(cost); },
-      py::arg("cost"),
-      "Min-cost assignment of rows to columns; inf = forbidden. Returns the column per row or -1.");
+      "solve_assignment",
+      [](const Eigen::MatrixXd& cost, double unmatched_pair_cost) {
+        return solveAssignment(cost, unmatched_pair_cost);
+      },
+      py::arg("cost"), py::arg("unmatched_pair_cost") = kForbidden,
+      "Min-cost assignment of rows to columns; inf = forbidden. Returns the column per row or -1. "
+      "unmatched_pair_cost inf (default): as many pairs as possible, then the least total cost; "
+      "finite L: the least sum of (cost - L), pairs costing L or more never taken (lap.lapjv "
+      "with cost_limit L, as ByteTrack calls it).");
 
   py::enum_<TrackState>(m, "TrackState")
       .value("TENTATIVE", TrackState::kTentative)
@@ -219,6 +225,12 @@ void bindTracking(py::module& m) {
                      "chi-square gate (2 dof, sum of covariances): re-identification after an "
                      "occlusion the gate could not bridge. 0.99999 -> 23.0.")
       .def_readwrite("min_iou", &TrackerConfig::min_iou, "image mode: minimum IoU to associate")
+      .def_readwrite(
+          "maximize_matches", &TrackerConfig::maximize_matches,
+          "Image mode: true (member default, SORT) makes as many pairs as the gate allows, then "
+          "the largest summed IoU; false (image default) the largest summed (IoU - min_iou), as "
+          "ByteTrack's lapjv with a cost limit, so one good pair is not traded for two poor ones. "
+          "Metric mode always maximises the pairs.")
       .def_readwrite(
           "accel_psd", &TrackerConfig::accel_psd,
           "Spectral density of the white acceleration noise. Metric: m^2/s^3 per axis. Image: box "

@@ -1110,6 +1110,7 @@ def gen_tracker(rng: np.random.Generator) -> dict[str, Any]:
         "initial_velocity_std": g.f(0.5, 2),
         "min_hits": g.i(1, 4, nasty=INT32_NASTY),
         "confirm_at_start": g.b(),
+        "maximize_matches": g.b(),
         "start_confirm_score": g.f(0.4, 0.8),
         "max_age_s": g.f(0.5, 3),
         "high_score": g.f(0.4, 0.7),

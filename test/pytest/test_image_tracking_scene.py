@@ -49,7 +49,10 @@ def results() -> dict[str, dict[str, list[Score]]]:
 
 
 # Per scene: MOTA, IDF1 floors and a ceiling on ID switches per 300 frames (mean of the seeds).
-FLOORS = {"street": (0.75, 0.74, 12.0), "crowd": (0.62, 0.52, 50.0)}
+# Measured 2026-12-04 with the IMAGE defaults: street 0.798 / 0.850 / 6.3, crowd 0.661 / 0.576 /
+# 38.3. The street's IDF1 floor fails with maximize_matches true (0.810: a coasting track took a
+# person's detection while the person's track took a false positive, seed 11).
+FLOORS = {"street": (0.77, 0.82, 10.0), "crowd": (0.63, 0.55, 45.0)}
 
 
 @pytest.mark.parametrize("name", sorted(IMAGE_SCENES))

@@ -62,6 +62,39 @@ def test_assignment_matches_brute_force() -> None:
         assert sum(cost[r, c] for r, c in pairs) == pytest.approx(cost_expected)
 
 
+def test_assignment_with_a_cost_limit_takes_one_good_pair_over_two_poor_ones() -> None:
+    # Issue 21: ByteTrack's lapjv(cost_limit=L) minimises the sum of (cost - L); the default
+    # maximises the pairs first.
+    cost = np.array([[0.15, 0.65], [0.5, np.inf]])
+    assert dp.solve_assignment(cost) == [1, 0]
+    assert dp.solve_assignment(cost, unmatched_pair_cost=0.7) == [0, -1]
+    assert dp.solve_assignment(cost, unmatched_pair_cost=0.15) == [-1, -1]  # nothing below L
+
+
+def test_image_defaults_do_not_maximize_matches() -> None:
+    # A person (left track) next to a coasting neighbour (right track, IoU 0.43); the frame holds
+    # the person's box and a false positive 60 px below it. Maximising the pairs hands the
+    # person to the coasting track; the image default keeps it with its own.
+    def outcome(maximize: bool) -> tuple[bool, bool]:
+        config = dp.TrackerConfig.defaults_for(dp.TrackerConfig.Mode.IMAGE)
+        config.maximize_matches = maximize
+        tracker = dp.Tracker(config)
+        pair = np.array([[100.0, 100.0, 150.0, 250.0], [120.0, 100.0, 170.0, 250.0]])
+        for k in range(25):
+            tracker.step(k / 25.0, pair, scores=np.full(2, 0.9))
+        left, right = (int(i) for i in tracker.last_assignment())
+        tracker.step(1.0, pair[:1], scores=np.array([0.9]))
+        boxes = np.vstack([pair[:1], [[100.0, 160.0, 150.0, 310.0]]])
+        tracker.step(1.04, boxes, scores=np.array([0.9, 0.6]))
+        person, false_positive = (int(i) for i in tracker.last_assignment())
+        return person == left, person == right and false_positive == left
+
+    assert not dp.TrackerConfig.defaults_for(dp.TrackerConfig.Mode.IMAGE).maximize_matches
+    assert dp.TrackerConfig().maximize_matches  # metric / member default: unchanged
+    assert outcome(maximize=False) == (True, False)
+    assert outcome(maximize=True) == (False, True)
+
+
 def test_tracker_keeps_ids_through_noise_misses_and_gaps() -> None:
     """Five objects in lanes 2 m apart at different speeds, 10 Hz, sigma 0.1 m, 90 % detection,
     one 1 s gap each (occlusion)."""

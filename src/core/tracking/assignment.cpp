@@ -62,7 +62,12 @@ std::vector<int> hungarian(const std::vector<std::vector<double>>& a, int n, int
 }  // namespace
 
 namespace {
-std::vector<int> solveDense(const Eigen::MatrixXd& cost);
+std::vector<int> solveDense(const Eigen::MatrixXd& cost, double unmatched_pair_cost);
+
+// A pair the solver may take: finite, and cheaper than leaving its row and column unassigned.
+bool allowed(double cost, double unmatched_pair_cost) {
+  return std::isfinite(cost) && cost < unmatched_pair_cost;
+}
 
 int findRoot(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
@@ -70,24 +75,27 @@ int findRoot(std::vector<int>& parent, int i) {
 }
 }  // namespace
 
-std::vector<int> solveAssignment(const Eigen::MatrixXd& cost) {
+std::vector<int> solveAssignment(const Eigen::MatrixXd& cost, double unmatched_pair_cost) {
   std::vector<CostEntry> entries;
   for (int r = 0; r < cost.rows(); ++r) {
     for (int c = 0; c < cost.cols(); ++c) {
       if (std::isfinite(cost(r, c))) entries.push_back({r, c, cost(r, c)});
     }
   }
-  return solveAssignment(static_cast<int>(cost.rows()), static_cast<int>(cost.cols()), entries);
+  return solveAssignment(static_cast<int>(cost.rows()), static_cast<int>(cost.cols()), entries,
+                         unmatched_pair_cost);
 }
 
-std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry>& entries) {
+std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry>& entries,
+                                 double unmatched_pair_cost) {
   // Gating leaves the matrix sparse: rows and columns linked by allowed pairs form independent
   // groups (objects far apart never compete), and each is solved on its own.
   std::vector<int> result(rows, -1);
   std::vector<int> parent(rows + cols);
   for (int i = 0; i < rows + cols; ++i) parent[i] = i;
   for (const CostEntry& e : entries) {
-    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols || !std::isfinite(e.cost)) {
+    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols ||
+        !allowed(e.cost, unmatched_pair_cost)) {
       continue;
     }
     const int a = findRoot(parent, e.row);
@@ -108,7 +116,8 @@ std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry
   }
   std::vector<std::vector<CostEntry>> group_entries(rows + cols);
   for (const CostEntry& e : entries) {
-    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols || !std::isfinite(e.cost)) {
+    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols ||
+        !allowed(e.cost, unmatched_pair_cost)) {
       continue;
     }
     group_entries[group_of[e.row]].push_back({local[e.row], local[rows + e.col], e.cost});
@@ -127,7 +136,7 @@ std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry
     Eigen::MatrixXd sub = Eigen::MatrixXd::Constant(
         static_cast<Eigen::Index>(gr.size()), static_cast<Eigen::Index>(gc.size()), kForbidden);
     for (const CostEntry& e : group_entries[g]) sub(e.row, e.col) = e.cost;
-    const std::vector<int> match = solveDense(sub);
+    const std::vector<int> match = solveDense(sub, unmatched_pair_cost);
     for (std::size_t i = 0; i < gr.size(); ++i) {
       if (match[i] >= 0) result[gr[i]] = gc[match[i]];
     }
@@ -137,13 +146,17 @@ std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry
 
 namespace {
 
-std::vector<int> solveDense(const Eigen::MatrixXd& cost) {
+std::vector<int> solveDense(const Eigen::MatrixXd& cost, double unmatched_pair_cost) {
   const int rows = static_cast<int>(cost.rows());
   const int cols = static_cast<int>(cost.cols());
   std::vector<int> result(rows, -1);
   if (rows == 0 || cols == 0) return result;
-  // A forbidden pair costs more than any set of allowed pairs together, so the optimum uses as
-  // few of them as possible (maximum cardinality first), and they are dropped afterwards.
+  const bool limited = std::isfinite(unmatched_pair_cost);
+  // Limited: an allowed pair costs (cost - limit) < 0 and a forbidden one 0, as much as leaving
+  // its row and column unassigned; the solver's complete assignment minus its forbidden pairs
+  // is then the best set of allowed pairs, however many. Unlimited: a forbidden pair costs more
+  // than any set of allowed pairs together, so the optimum uses as few of them as possible
+  // (maximum cardinality first). Forbidden pairs are dropped afterwards either way.
   double max_allowed = 0.0;
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
@@ -159,7 +172,11 @@ std::vector<int> solveDense(const Eigen::MatrixXd& cost) {
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < m; ++j) {
       const double x = transpose ? cost(j, i) : cost(i, j);
-      a[i + 1][j + 1] = std::isfinite(x) ? x : big;
+      if (limited) {
+        a[i + 1][j + 1] = allowed(x, unmatched_pair_cost) ? x - unmatched_pair_cost : 0.0;
+      } else {
+        a[i + 1][j + 1] = std::isfinite(x) ? x : big;
+      }
     }
   }
   const std::vector<int> match = hungarian(a, n, m);
@@ -167,7 +184,7 @@ std::vector<int> solveDense(const Eigen::MatrixXd& cost) {
     const int j = match[i];
     if (j < 0) continue;
     const double x = transpose ? cost(j, i) : cost(i, j);
-    if (!std::isfinite(x)) continue;
+    if (!allowed(x, unmatched_pair_cost)) continue;
     if (transpose) {
       result[j] = i;
     } else {

@@ -48,6 +48,7 @@ TrackerConfig TrackerConfig::defaultsFor(Mode mode) {
   if (mode == Mode::kImage) {
     config.min_hits = 2;
     config.confirm_at_start = true;
+    config.maximize_matches = false;
   }
   return config;
 }
@@ -66,6 +67,7 @@ std::vector<std::pair<std::string, double>> TrackerConfig::modeSpecificDefaults(
       {"initial_velocity_std", {metric.initial_velocity_std, own.initial_velocity_std}},
       {"min_hits", {metric.min_hits, own.min_hits}},
       {"confirm_at_start", {metric.confirm_at_start, own.confirm_at_start}},
+      {"maximize_matches", {metric.maximize_matches, own.maximize_matches}},
       {"start_confirm_score", {metric.start_confirm_score, own.start_confirm_score}},
       {"max_age_s", {metric.max_age_s, own.max_age_s}},
       {"high_score", {metric.high_score, own.high_score}},
@@ -262,6 +264,14 @@ struct Core : Tracker::Impl {
     }
   }
 
+  // What leaving a track and a detection unpaired costs the assignment (solveAssignment):
+  // infinite maximises the pairs; in image mode without maximize_matches, the cost of a pair at
+  // min_iou (1 - min_iou, nudged up so that such a pair may still be made, as the gate allows).
+  double unmatchedPairCost() const {
+    if (D == 2 || config.maximize_matches) return kForbidden;
+    return std::nextafter(1.0 - config.min_iou, kForbidden);
+  }
+
   // Assigns detections `dets` (indices) to tracks `cands` (indices); fills match_of_track.
   std::size_t associate(const std::vector<std::size_t>& cands, const std::vector<std::size_t>& dets,
                         const std::vector<Detection>& all, const std::vector<Vec>& z,
@@ -322,7 +332,8 @@ struct Core : Tracker::Impl {
       });
     }
     const std::vector<int> match =
-        solveAssignment(static_cast<int>(cands.size()), static_cast<int>(dets.size()), entries);
+        solveAssignment(static_cast<int>(cands.size()), static_cast<int>(dets.size()), entries,
+                        unmatchedPairCost());
     std::size_t matched = 0;
     for (std::size_t i = 0; i < cands.size(); ++i) {
       if (match[i] < 0) continue;

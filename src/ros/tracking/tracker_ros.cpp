@@ -76,7 +76,7 @@ void TrackerRos::applyModeDefaults(TrackerConfig::Mode mode) {
     if (pnh_.hasParam(name)) continue;
     if (name == "min_hits") {  // the one integer parameter: the server reads it as an int
       pnh_.setParam(name, static_cast<int>(value));
-    } else if (name == "confirm_at_start") {  // the one boolean: read as a bool
+    } else if (name == "confirm_at_start" || name == "maximize_matches") {  // read as bools
       pnh_.setParam(name, value != 0.0);
     } else {
       pnh_.setParam(name, value);
@@ -129,6 +129,7 @@ void TrackerRos::reconfigure(TrackerNodeConfig& c, std::uint32_t) {
   next.initial_velocity_std = c.initial_velocity_std;
   next.min_hits = c.min_hits;
   next.confirm_at_start = c.confirm_at_start;
+  next.maximize_matches = c.maximize_matches;
   next.start_confirm_score = c.start_confirm_score;
   next.max_age_s = c.max_age_s;
   next.high_score = c.high_score;

@@ -54,6 +54,8 @@ TEST(TrackerModeDefaults, ImageModeListsExactlyTheFieldsItChanges) {
       rebuilt.min_hits = static_cast<int>(value);
     } else if (name == "confirm_at_start") {
       rebuilt.confirm_at_start = value != 0.0;
+    } else if (name == "maximize_matches") {
+      rebuilt.maximize_matches = value != 0.0;
     } else if (name == "max_age_s") {
       rebuilt.max_age_s = value;
     } else if (name == "accel_psd") {
@@ -70,6 +72,7 @@ TEST(TrackerModeDefaults, ImageModeListsExactlyTheFieldsItChanges) {
   }
   EXPECT_EQ(rebuilt.min_hits, image.min_hits);
   EXPECT_EQ(rebuilt.confirm_at_start, image.confirm_at_start);
+  EXPECT_EQ(rebuilt.maximize_matches, image.maximize_matches);
   EXPECT_EQ(rebuilt.max_age_s, image.max_age_s);
   EXPECT_EQ(rebuilt.accel_psd, image.accel_psd);
   EXPECT_EQ(rebuilt.measurement_std, image.measurement_std);

@@ -12,10 +12,17 @@ namespace downstream_perception {
 /// Pairs with cost >= kForbidden (or non-finite) may not be assigned.
 constexpr double kForbidden = std::numeric_limits<double>::infinity();
 
-/// Minimum-cost assignment of rows to columns of `cost` (rows x cols, any shape). Among all
-/// assignments it first maximises the number of allowed pairs, then minimises their total cost.
-/// Returns, per row, the assigned column or -1.
-std::vector<int> solveAssignment(const Eigen::MatrixXd& cost);
+/// Minimum-cost assignment of rows to columns of `cost` (rows x cols, any shape). Returns, per
+/// row, the assigned column or -1.
+///
+/// `unmatched_pair_cost` is what leaving a row and a column unassigned costs, against taking
+/// their pair. Infinite (the default): among all assignments the solver first maximises the
+/// number of allowed pairs, then minimises their total cost. Finite (L): it minimises the sum of
+/// (cost - L) over the pairs it takes, so a pair is taken only where it beats leaving both
+/// unassigned and pairs costing L or more never are (lap.lapjv with cost_limit L, as ByteTrack
+/// calls it): one good pair is not traded for two poor ones.
+std::vector<int> solveAssignment(const Eigen::MatrixXd& cost,
+                                 double unmatched_pair_cost = kForbidden);
 
 /// An allowed pair of a sparse cost matrix.
 struct CostEntry {
@@ -26,6 +33,7 @@ struct CostEntry {
 
 /// The same for a sparse matrix: only the listed pairs are allowed (each pair at most once).
 /// Work grows with the pairs and the size of the groups they link, not with rows x cols.
-std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry>& entries);
+std::vector<int> solveAssignment(int rows, int cols, const std::vector<CostEntry>& entries,
+                                 double unmatched_pair_cost = kForbidden);
 
 }  // namespace downstream_perception

@@ -78,6 +78,15 @@ struct TrackerConfig {
   /// 0.99999 -> 23.0.
   double reid_confidence = 0.99999;
   double min_iou = 0.3;  ///< image mode: minimum IoU to associate
+  /// Image mode: how each association pass chooses among the pairs its gate allows. true (the
+  /// member default, and SORT's gated Hungarian): as many pairs as possible first, then the
+  /// largest summed IoU. false (image default, see defaultsFor): the largest summed (IoU -
+  /// min_iou), ByteTrack's lapjv with a cost limit, so a pair is made only where it beats
+  /// leaving both unmatched: a coasting track next to a person no longer takes that person's
+  /// detection so that the person's own track can take a poor one (a false positive, a
+  /// neighbour's box), which handed identities over. Metric mode always maximises the pairs (its
+  /// cost has no fixed limit; the chi-square gate decides which pairs may be).
+  bool maximize_matches = true;
   /// Spectral density of the white acceleration noise. Metric: m^2/s^3 per axis. Image: box
   /// heights^2/s^3 (px^2/s^3 per px^2 of box height), so it scales with the apparent size.
   double accel_psd = 0.5;
