@@ -150,7 +150,11 @@ void VoxelObstacleLayer::onInitialize() {
   // each source upward (searchParam, readSource); transform_tolerance is validated only (the
   // MessageFilter waits for each message's own transform, as in costmap_2d in practice).
   reader.known({"obstacle_range", "raytrace_range"});
-  reader.known(stvlLayerKeys());  // an STVL configuration's: adopted by the host (stvl_keys.h)
+  // STVL's keys belong to this layer only where the costmap host adopted them (the layer's type
+  // was STVL's, stvl_keys.h); in any other configuration they are unknown keys like any other.
+  stvl_configuration_ = false;
+  reader.get("stvl_configuration", &stvl_configuration_);
+  if (stvl_configuration_) reader.known(stvlLayerKeys());
   double transform_tolerance = 0.2;
   reader.get("transform_tolerance", &transform_tolerance);
   if (!std::isfinite(transform_tolerance) || transform_tolerance < 0.0) {
@@ -170,7 +174,10 @@ void VoxelObstacleLayer::onInitialize() {
     }
   }
   reader.warnUnknown();
-  param_warnings_ = reader.warnings();
+  // The layer's own warnings first; the sources' (readSource) follow. (An assignment here used
+  // to drop the sources' warnings, among them their unknown keys, from the diagnostics.)
+  const std::vector<std::string> layer_warnings = reader.warnings();
+  param_warnings_.insert(param_warnings_.begin(), layer_warnings.begin(), layer_warnings.end());
   if (publish_voxel_map_) voxel_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("voxel_cloud", 1);
   matchSize();
   const bool enabled = enabled_;

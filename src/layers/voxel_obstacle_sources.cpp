@@ -35,7 +35,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
   search("raytrace_range", &s->rays.raytrace_max_range_m);
   s->rays.no_return_range_m = s->rays.raytrace_max_range_m;
   reader.known({"obstacle_range", "raytrace_range"});
-  reader.known(stvlSourceKeys());  // an STVL configuration's: adopted by the host
+  if (stvl_configuration_) reader.known(stvlSourceKeys());  // adopted by the host (stvl_keys.h)
   reader.get("no_return_range", &s->rays.no_return_range_m);
   reader.get("camera_info_topic", &s->camera_info_topic);
   reader.get("zero_is_no_return", &s->zero_is_no_return);

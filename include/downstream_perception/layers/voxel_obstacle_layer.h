@@ -136,6 +136,7 @@ class VoxelObstacleLayer : public Layer {
   bool track_unknown_space_ = true;
   int combination_method_ = 1;  ///< 0 overwrite, 1 maximum (costmap_2d's default)
   bool publish_voxel_map_ = false;
+  bool stvl_configuration_ = false;         ///< STVL's keys were adopted by the host (stvl_keys.h)
   bool footprint_clearing_enabled_ = true;  ///< costmap_2d's default
   std::vector<std::size_t> footprint_cells_;
   std::vector<std::pair<int, int>> footprint_columns_;

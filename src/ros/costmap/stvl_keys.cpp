@@ -91,6 +91,8 @@ void adoptSourceKeys(ros::NodeHandle& nh, const std::string& who, std::vector<st
 
 std::vector<std::string> adoptStvlKeys(ros::NodeHandle& nh, double costmap_resolution_m,
                                        const std::string& who) {
+  // Tells the layer that STVL's keys are its own here (else they are unknown keys).
+  nh.setParam("stvl_configuration", true);
   std::vector<std::string> notes;
   double voxel_size = kStvlVoxelSizeM;
   NodeParams{nh}.get("voxel_size", &voxel_size);

@@ -8,11 +8,13 @@ top) and nothing between the floor and the top is occupied. The open floor is no
 
 from __future__ import annotations
 
+import threading
 import unittest
 
 import numpy as np
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs import point_cloud2
 from sensor_msgs.msg import PointCloud2
 from std_msgs.msg import Bool
@@ -39,6 +41,15 @@ class VoxelLayerTest(unittest.TestCase):
             pts = list(point_cloud2.read_points(msg, field_names=("x", "y", "z")))
             cls.voxels = np.asarray(pts, dtype=float).reshape(-1, 3)
 
+        cls.lock = threading.Lock()
+        cls.warnings: list[str] = []
+
+        def on_diagnostics(msg: DiagnosticArray) -> None:
+            with cls.lock:
+                for status in msg.status:
+                    cls.warnings += [kv.value for kv in status.values if "warning" in kv.key]
+
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=20)
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
         rospy.Subscriber("/costmap/voxels/voxel_cloud", PointCloud2, on_voxels, queue_size=1)
         cls.costmap = CostmapClient("/costmap/costmap")
@@ -66,6 +77,18 @@ class VoxelLayerTest(unittest.TestCase):
         # The open floor between the objects: not lethal.
         self.assertNotEqual(self.costmap.cell(0.0, 1.3), 100)
         self.assertNotEqual(self.costmap.cell(-1.0, -1.5), 100)
+
+    def test_stvl_keys_outside_an_stvl_configuration_are_unknown(self) -> None:
+        # The layer's type is ours, not STVL's: STVL's keys are not adopted, so they are warned
+        # as unknown keys (compatibility rule: no key is ignored silently).
+        def warned(key: str) -> bool:
+            with self.lock:
+                return any(f"{key} is not a key" in w for w in self.warnings)
+
+        self.assertTrue(wait_until(lambda: warned("/costmap/voxels/voxel_decay"), 20.0))
+        self.assertTrue(
+            wait_until(lambda: warned("/costmap/voxels/depth/max_z"), 5.0), str(self.warnings[-8:])
+        )
 
     def test_removed_box_is_cleared(self) -> None:
         # voxel_layer_frustum.test: the simulator took the box away after half of the frames.

@@ -26,8 +26,10 @@ const std::vector<std::string>& stvlSourceKeys();
 /// z_voxels, voxel_decay / decay_model -> decay_time_s (ours is exponential: a WARN),
 /// update_footprint_enabled -> footprint_clearing_enabled; per source: data_type PointCloud2,
 /// max_z (10 m) -> raytrace_range of a clearing source; the frustum model, min_z, the voxel
-/// filter, clear_after_reading false and mapping_mode are differences (a WARN each). Returns the
-/// WARN texts (also logged, prefixed by `who`).
+/// filter, clear_after_reading false and mapping_mode are differences (a WARN each). Sets the
+/// layer's `stvl_configuration` (true), which makes the layer read STVL's keys as its own (in any
+/// other configuration they are unknown keys, warned as such). Returns the WARN texts (also
+/// logged, prefixed by `who`).
 std::vector<std::string> adoptStvlKeys(ros::NodeHandle& layer_nh, double costmap_resolution_m,
                                        const std::string& who);
 
