@@ -1076,6 +1076,13 @@ class ScanIntegrator:
         """
         the configuration in use
         """
+    @property
+    def threads(self) -> int:
+        """
+        threads of the clearing walk: 1, or 2 (the default where the machine has two cores) for dense scans (200,000 ray cells or more); the grid is the same bit for bit
+        """
+    @threads.setter
+    def threads(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None: ...
 
 class StaticMapConfig:
     """

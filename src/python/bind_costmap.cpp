@@ -222,6 +222,10 @@ void bindScanIntegration(py::module& m) {
       .def(py::init<const ScanIntegratorConfig&>(),
            py::arg_v("config", ScanIntegratorConfig{}, "ScanIntegratorConfig()"))
       .def_property_readonly("config", &ScanIntegrator::config, "the configuration in use")
+      .def_property("threads", &ScanIntegrator::threads, &ScanIntegrator::setThreads,
+                    "threads of the clearing walk: 1, or 2 (the default where the machine has "
+                    "two cores) for dense scans (200,000 ray cells or more); the grid is the same "
+                    "bit for bit")
       .def(
           "integrate",
           [](ScanIntegrator& self, LogOddsGrid& grid,
