@@ -150,6 +150,7 @@ void Inflator::setConfig(const InflationConfig& config, double resolution_m) {
   for (std::int64_t d2 = 0; d2 <= max_d2; ++d2) {
     cost_by_d2_[d2] = inflationCost(std::sqrt(static_cast<double>(d2)) * resolution_m, config);
   }
+  buildKernel();
   full_recompute_ = true;
 }
 
@@ -244,14 +245,22 @@ void Inflator::markDirty(const CellBounds& cells) {
   }
 }
 
-void Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
-  recompute(region, g, &scratch_);
+bool Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
+  return recompute(region, g, &scratch_);
 }
 
-void Inflator::recompute(const CellBounds& region, const GridGeometry& g,
+bool Inflator::recompute(const CellBounds& region, const GridGeometry& g,
                          std::vector<std::int32_t>* scratch) {
-  if (region.empty()) return;
+  if (region.empty()) return false;
   const CellBounds sources = grow(region, radius_cells_, g);
+  if (stamp_ok_ && method_ != InflationMethod::kTransform) {
+    scratch->clear();
+    collectBoundary(sources, g, scratch);
+    if (preferStamp(scratch->size() / 2, area(sources))) {
+      stampRegion(scratch->data(), scratch->data() + scratch->size(), region, g, true);
+      return true;
+    }
+  }
   boundedSquaredDistances(lethal_.data(), g.sizeX(), sources, region, radius_cells_, scratch);
   const int w = region.max_x - region.min_x + 1;
   for (int y = region.min_y; y <= region.max_y; ++y) {
@@ -259,6 +268,7 @@ void Inflator::recompute(const CellBounds& region, const GridGeometry& g,
     std::uint8_t* c = costs_.data() + g.index(region.min_x, y);
     for (int x = 0; x < w; ++x) c[x] = costOfSquaredDistance(d2[x]);
   }
+  return false;
 }
 
 void Inflator::recomputeDirtyTiles(const GridGeometry& g, InflationStats* stats) {
@@ -284,13 +294,13 @@ void Inflator::recomputeDirtyTiles(const GridGeometry& g, InflationStats* stats)
       tile = 0;
       if (one_region) continue;
       const CellBounds region = tileCells(tx, ty);
-      recompute(region, g);
+      stats->regions_stamped += recompute(region, g) ? 1 : 0;
       ++stats->regions;
       stats->cells_recomputed += area(region);
     }
   }
   if (one_region) {
-    recompute(merged, g);
+    stats->regions_stamped = recompute(merged, g) ? 1 : 0;
     stats->regions = 1;
     stats->cells_recomputed = area(merged);
   }
@@ -316,7 +326,7 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
     full_recompute_ = false;
   } else {
     for (const CellBounds& region : pending_regions_) {  // edges after a rolling-window shift
-      recompute(region, g);
+      stats.regions_stamped += recompute(region, g) ? 1 : 0;
       ++stats.regions;
       stats.cells_recomputed += area(region);
     }
