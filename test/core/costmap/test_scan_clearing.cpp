@@ -121,7 +121,24 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     const IntegrationStats a = integrateBeams(blocks, scan, &scratch, ClearingWalk::kBlockSkip);
     const IntegrationStats b = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
     const IntegrationStats c = integrateBeams(automatic, scan, &auto_scratch, ClearingWalk::kAuto);
+    const std::vector<int> before = oracle;
     oracleIntegrate(g, per_ray, &oracle, scan);
+    // The oracle's statistics: cells whose state class (free / unknown / occupied) changed.
+    std::size_t changed = 0;
+    CellBounds changed_box;
+    const auto cls = [&](int v) {
+      return (v > per_ray.occupiedUnits()) - (v < per_ray.freeUnits());
+    };
+    for (std::size_t i = 0; i < g.cellCount(); ++i) {
+      if (cls(before[i]) == cls(oracle[i])) continue;
+      ++changed;
+      changed_box.expand(static_cast<int>(i % g.sizeX()), static_cast<int>(i / g.sizeX()));
+    }
+    EXPECT_EQ(b.cells_changed, changed) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.min_x, changed_box.min_x) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.max_x, changed_box.max_x) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.min_y, changed_box.min_y) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.max_y, changed_box.max_y) << "seed " << seed << " scan " << s;
     expectSameStats(a, b);
     expectSameStats(c, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
@@ -151,6 +168,26 @@ TEST(ScanClearing, DenseScansSaturateAndStillMatch) {
   const GridGeometry g(200, 170, 0.05, -4.3, -4.1);
   compareWalks(77, g, 40, 3600, false);
   compareWalks(78, g, 10, 3600, true);
+}
+
+TEST(ScanClearing, SaturatingMissesMatchTheOracle) {
+  // A binary-like model (one miss takes a cell to the lower clamp, one hit marks it): the walk
+  // leaves such cells unflagged, so later rays of the same scan must still skip them, hits must
+  // still win over misses, and the next scan must update them again. Against the oracle, with
+  // its statistics, on first scans (all unknown) and on repeated dense ones.
+  LogOddsConfig binary;
+  binary.p_hit = 0.99;
+  binary.p_miss = 0.01;
+  binary.clamp_min = -2.1;
+  binary.clamp_max = 2.1;
+  compareWalks(91, GridGeometry(120, 90, 0.05, -2.9, -2.1), 12, 720, false, binary);
+  compareWalks(92, GridGeometry(200, 170, 0.05, -4.3, -4.1), 8, 3600, true, binary);
+  // A miss that reaches the clamp only from some values: -0.9 per miss against a clamp of -2.
+  LogOddsConfig partial;
+  partial.p_miss = 0.29;
+  partial.clamp_min = -2.05;
+  partial.free_threshold = -1.0;
+  compareWalks(93, GridGeometry(90, 110, 0.1, 0.3, -1.7), 20, 500, false, partial);
 }
 
 TEST(ScanClearing, AxisAlignedAndSingleCellRays) {
