@@ -170,6 +170,100 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlong(const RayWalk& w
   return p;
 }
 
+// The mark walk of ClearingWalk::kMarkSweep: the cells of clearAlong / clearThroughCorners (the
+// same steps) set to 1 in `crossed` (the grid's layout, one byte per cell), from index `i`;
+// returns the end cell's index. Stores only: nothing waits for a cell's value.
+__attribute__((noinline)) std::ptrdiff_t markAlong(const RayWalk& walk, std::ptrdiff_t i,
+                                                   std::uint8_t* crossed, std::ptrdiff_t size_x,
+                                                   std::size_t* walked) {
+  const std::ptrdiff_t dpx = walk.sx;
+  const std::ptrdiff_t dpy = walk.sy * size_x;
+  const std::int64_t esx = walk.err_step_x;
+  const std::int64_t esy = walk.err_step_y;
+  std::int64_t err = walk.err;
+  int left = walk.stepsLeft();
+  if (__builtin_expect(walk.corners, 0)) {
+    for (; left > 0; --left) {
+      crossed[i] = 1;
+      ++*walked;
+      if (err == walk.tie && left >= 2) {
+        i += dpx + dpy;
+        err += esx - esy;
+        --left;
+      } else if (err <= 0) {
+        i += dpx;
+        err += esx;
+      } else {
+        i += dpy;
+        err -= esy;
+      }
+    }
+    return i;
+  }
+  *walked += static_cast<std::size_t>(left);
+  for (; left > 0; --left) {
+    crossed[i] = 1;
+    const bool step_x = err <= 0;
+    i += step_x ? dpx : dpy;
+    err += step_x ? esx : -esy;
+  }
+  return i;
+}
+
+// The sweep of ClearingWalk::kMarkSweep over `box`: every crossed cell not flagged (hit in this
+// scan) and not saturated free takes its miss, unflagged (nothing of this scan visits it again);
+// the marks go back to 0. Counts and bounds the cells whose state class changed, in row order.
+void sweepCrossed(const ScanCells& sc, std::uint8_t* crossed, const CellBounds& box,
+                  std::vector<std::uint8_t>* row_changed) {
+  const int w = box.max_x - box.min_x + 1;
+  row_changed->resize(static_cast<std::size_t>(w));
+  std::uint8_t* ch = row_changed->data();
+  // All in int16 so that the row loop vectorises (|value| <= 16383, |miss| <= 16383: the sums
+  // fit). A cell the loop does not miss gets its own value back.
+  const auto sat = static_cast<std::int16_t>(sc.saturated_free_raw);
+  const auto lo = static_cast<std::int16_t>(sc.lo);
+  const auto hi = static_cast<std::int16_t>(sc.hi);
+  const auto miss_units = static_cast<std::int16_t>(sc.miss_units);
+  const auto occ = static_cast<std::int16_t>(sc.occupied_units);
+  const auto fre = static_cast<std::int16_t>(sc.free_units);
+  for (int y = box.min_y; y <= box.max_y; ++y) {
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * sc.size_x + box.min_x;
+    std::uint8_t* m = crossed + row;
+    std::int16_t* c = sc.cells + row;
+    int changed = 0;
+    for (int x = 0; x < w; ++x) {
+      // Selects on int16 only (no bool), so that GCC vectorises the loop.
+      const std::int16_t raw = c[x];
+      const std::int16_t one = 1;
+      const std::int16_t zero = 0;
+      const auto miss =
+          static_cast<std::int16_t>(m[x] & ((raw & 1) ^ 1) & (raw == sat ? zero : one));
+      const auto old_v = static_cast<std::int16_t>(raw >> 1);  // exact when miss (raw even)
+      auto v = static_cast<std::int16_t>(old_v + miss_units);
+      v = v < lo ? lo : v;
+      v = v > hi ? hi : v;
+      c[x] = miss != 0 ? static_cast<std::int16_t>(v * 2) : raw;
+      m[x] = 0;
+      const auto class_old =
+          static_cast<std::int16_t>((old_v > occ ? one : zero) - (old_v < fre ? one : zero));
+      const auto class_new =
+          static_cast<std::int16_t>((v > occ ? one : zero) - (v < fre ? one : zero));
+      const auto changed_here =
+          static_cast<std::int16_t>(miss & (class_old != class_new ? one : zero));
+      ch[x] = static_cast<std::uint8_t>(changed_here);
+      changed += changed_here;
+    }
+    if (changed == 0) continue;
+    int first = 0;
+    while (!ch[first]) ++first;
+    int last = w - 1;
+    while (!ch[last]) --last;
+    sc.stats->cells_changed += static_cast<std::size_t>(changed);
+    sc.stats->changed.expand(box.min_x + first, y);
+    sc.stats->changed.expand(box.min_x + last, y);
+  }
+}
+
 // Blocks of kBlock x kBlock cells (a power of two).
 constexpr int kBlockShift = 5;
 constexpr int kBlock = 1 << kBlockShift;
@@ -206,6 +300,11 @@ double saturatedFreeShare(const ScanCells& sc, const CellBounds& box) {
 }
 
 }  // namespace
+
+bool autoChoosesMarkSweep(std::size_t ray_cells, std::size_t box_cells,
+                          double saturated_free_share) {
+  return 2 * ray_cells >= box_cells && saturated_free_share < kAutoMinSaturatedShare;
+}
 
 bool autoChoosesBlockWalk(std::size_t ray_cells, std::size_t box_cells,
                           double saturated_free_share) {
@@ -420,9 +519,32 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                                     ? 0
                                     : static_cast<std::size_t>(box.max_x - box.min_x + 1) *
                                           static_cast<std::size_t>(box.max_y - box.min_y + 1);
+  const double saturated_share =
+      walk_kind == ClearingWalk::kAuto && !box.empty() ? saturatedFreeShare(sc, box) : 0.0;
   const bool use_blocks = walk_kind == ClearingWalk::kBlockSkip ||
                           (walk_kind == ClearingWalk::kAuto && !box.empty() &&
-                           autoChoosesBlockWalk(steps, box_cells, saturatedFreeShare(sc, box)));
+                           autoChoosesBlockWalk(steps, box_cells, saturated_share));
+  const bool mark_sweep = !use_blocks && !box.empty() &&
+                          (walk_kind == ClearingWalk::kMarkSweep ||
+                           (walk_kind == ClearingWalk::kAuto &&
+                            autoChoosesMarkSweep(steps, box_cells, saturated_share)));
+  if (mark_sweep) {
+    if (s.crossed.size() != geometry.cellCount()) s.crossed.assign(geometry.cellCount(), 0);
+    std::size_t walked = 0;
+    for (const ClearingRay& ray : rays) {
+      const RayWalk& walk = ray.walk;
+      const std::ptrdiff_t end =
+          markAlong(walk, walk.cy * sc.size_x + walk.cx, s.crossed.data(), sc.size_x, &walked);
+      if (ray.clear_end_cell) {
+        ++walked;
+        s.crossed[end] = 1;
+      }
+    }
+    stats.cells_cleared = walked;
+    sweepCrossed(sc, s.crossed.data(), box, &s.row_changed);
+    for (const std::uint32_t i : flagged) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
+    return stats;
+  }
   if (use_blocks) {
     const int bx = static_cast<int>((geometry.sizeX() + kBlock - 1) >> kBlockShift);
     const int by = static_cast<int>((geometry.sizeY() + kBlock - 1) >> kBlockShift);

@@ -95,9 +95,11 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
   LogOddsGrid blocks(g, model);
   LogOddsGrid per_ray(g, model);
   LogOddsGrid automatic(g, model);
+  LogOddsGrid swept(g, model);
   std::vector<int> oracle(g.cellCount(), 0);
   IntegrationScratch scratch;  // reused across scans, as the integrator does
   IntegrationScratch auto_scratch;
+  IntegrationScratch sweep_scratch;
   const double w = g.sizeX() * g.resolution();
   const double h = g.sizeY() * g.resolution();
   std::uniform_real_distribution<double> ux(g.originX() - 0.1 * w, g.originX() + 1.1 * w);
@@ -121,6 +123,8 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     const IntegrationStats a = integrateBeams(blocks, scan, &scratch, ClearingWalk::kBlockSkip);
     const IntegrationStats b = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
     const IntegrationStats c = integrateBeams(automatic, scan, &auto_scratch, ClearingWalk::kAuto);
+    const IntegrationStats d =
+        integrateBeams(swept, scan, &sweep_scratch, ClearingWalk::kMarkSweep);
     const std::vector<int> before = oracle;
     oracleIntegrate(g, per_ray, &oracle, scan);
     // The oracle's statistics: cells whose state class (free / unknown / occupied) changed.
@@ -141,9 +145,11 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     EXPECT_EQ(b.changed.max_y, changed_box.max_y) << "seed " << seed << " scan " << s;
     expectSameStats(a, b);
     expectSameStats(c, b);
+    expectSameStats(d, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
+      ASSERT_EQ(swept.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(blocks.units(i), oracle[i]) << "seed " << seed << " scan " << s << " cell " << i;
     }
   }
@@ -257,4 +263,20 @@ TEST(ScanClearing, AutoTakesTheBlockWalkOnlyForDenseRaysOverSeenSpace) {
   // Sparse rays (fewer cells than the box): per ray, saturated or not.
   EXPECT_FALSE(autoChoosesBlockWalk(1000, 1000, 1.0));
   EXPECT_FALSE(autoChoosesBlockWalk(10, 1000, 1.0));
+}
+
+TEST(ScanClearing, AutoTakesMarkSweepForDenseRaysOverUnseenSpace) {
+  // Rays crossing at least half the box's cells over a box less than a quarter saturated.
+  EXPECT_TRUE(autoChoosesMarkSweep(500, 1000, 0.0));
+  EXPECT_TRUE(autoChoosesMarkSweep(2000, 1000, 0.24));
+  EXPECT_FALSE(autoChoosesMarkSweep(499, 1000, 0.0));    // sparse: the sweep would cost more
+  EXPECT_FALSE(autoChoosesMarkSweep(2000, 1000, 0.25));  // seen space: the block walk's case
+  // A first dense scan on a real grid takes it, and its marks are all cleared afterwards.
+  const GridGeometry g(300, 260, 0.05, -7.5, -6.5);
+  LogOddsGrid grid(g);
+  IntegrationScratch scratch;
+  std::mt19937 rng(5);
+  integrateBeams(grid, randomScan(&rng, 0.01, 0.02, 3600, 7.0), &scratch, ClearingWalk::kAuto);
+  ASSERT_EQ(scratch.crossed.size(), g.cellCount());
+  for (const std::uint8_t mark : scratch.crossed) ASSERT_EQ(mark, 0);
 }
