@@ -255,8 +255,8 @@ bool Inflator::recompute(const CellBounds& region, const GridGeometry& g,
   const CellBounds sources = grow(region, radius_cells_, g);
   if (stamp_ok_ && method_ != InflationMethod::kTransform) {
     scratch->clear();
-    collectBoundary(sources, g, scratch);
-    if (preferStamp(scratch->size() / 2, area(sources))) {
+    const std::size_t boundary = collectBoundary(sources, g, scratch);
+    if (preferStamp(scratch->size() / 3, boundary, area(sources))) {
       stampRegion(scratch->data(), scratch->data() + scratch->size(), region, g, true);
       return true;
     }

@@ -72,14 +72,16 @@ void Inflator::buildKernel() {
   stamp_ok_ = true;
 }
 
-void Inflator::collectBoundary(const CellBounds& box, const GridGeometry& g,
-                               std::vector<std::int32_t>* cells) const {
+std::size_t Inflator::collectBoundary(const CellBounds& box, const GridGeometry& g,
+                                      std::vector<std::int32_t>* runs) const {
   const int sx = g.sizeX();
   const int sy = g.sizeY();
+  std::size_t cells = 0;
   for (int y = box.min_y; y <= box.max_y; ++y) {
     const std::uint8_t* row = lethal_.data() + static_cast<std::size_t>(y) * sx;
     const std::uint8_t* up = y > 0 ? row - sx : nullptr;
     const std::uint8_t* down = y + 1 < sy ? row + sx : nullptr;
+    int run_end = -2;  // last x of the run being built in this row (-2: none)
     int x = box.min_x;
     while (x <= box.max_x) {
       if (x + 8 <= box.max_x + 1 && !anySet8(row + x)) {  // skip free cells 8 at a time
@@ -90,19 +92,29 @@ void Inflator::collectBoundary(const CellBounds& box, const GridGeometry& g,
         const bool boundary = (x > 0 && !row[x - 1]) || (x + 1 < sx && !row[x + 1]) ||
                               (up != nullptr && !up[x]) || (down != nullptr && !down[x]);
         if (boundary) {
-          cells->push_back(x);
-          cells->push_back(y);
+          ++cells;
+          if (run_end == x - 1) {
+            (*runs)[runs->size() - 2] = x;  // extends the run: (x0, x1, y)
+          } else {
+            runs->insert(runs->end(), {x, x, y});
+          }
+          run_end = x;
         }
       }
       ++x;
     }
   }
+  return cells;
 }
 
-bool Inflator::preferStamp(std::size_t boundary_cells, std::size_t source_cells) const {
+bool Inflator::preferStamp(std::size_t runs, std::size_t boundary_cells,
+                           std::size_t source_cells) const {
   if (!stamp_ok_ || method_ == InflationMethod::kTransform) return false;
   if (method_ == InflationMethod::kStamp) return true;
-  return boundary_cells * stamp_ops_ <= kTransformOpsPerCell * source_cells;
+  // A run of L cells costs one stamp plus L - 1 more bytes per stamp row (see stampRegion).
+  const std::size_t work =
+      runs * stamp_ops_ + (boundary_cells - runs) * kernel_half_width_.size() / kChunk;
+  return work <= kTransformOpsPerCell * source_cells;
 }
 
 void Inflator::stampRegion(const std::int32_t* begin, const std::int32_t* end,
@@ -118,35 +130,59 @@ void Inflator::stampRegion(const std::int32_t* begin, const std::int32_t* end,
   }
   const int r = radius_cells_;
   const std::size_t stride = kernelStride();
-  for (const std::int32_t* p = begin; p != end; p += 2) {
-    const int cx = p[0];
-    const int cy = p[1];
+  for (const std::int32_t* p = begin; p != end; p += 3) {
+    const int ax = p[0];  // the run of boundary cells (ax .. bx, cy)
+    const int bx = p[1];
+    const int cy = p[2];
     const int y0 = std::max(clip.min_y, cy - r);
     const int y1 = std::min(clip.max_y, cy + r);
     for (int y = y0; y <= y1; ++y) {
       const int k = y - cy + r;
       const int hw = kernel_half_width_[k];
       if (hw < 0) continue;
-      const int x0 = std::max(clip.min_x, cx - hw);
-      const int x1 = std::min(clip.max_x, cx + hw);
-      if (x0 > x1) continue;
-      const std::uint8_t* kr =
-          kernel_.data() + static_cast<std::size_t>(k) * stride + (x0 - cx + r);
-      std::uint8_t* c = costs_.data() + static_cast<std::size_t>(y) * sx + x0;
-      // Whole 16-byte chunks where they stay inside the clip: the kernel row is 0 beyond hw (and
-      // padded), so the bytes past the disc take max(c, 0) = c; one vector max per chunk instead
-      // of a loop with a scalar tail for every row of every stamp.
-      const int chunks = (2 * hw + 1 + kChunk - 1) / kChunk;
-      if (x0 == cx - hw && x0 + chunks * kChunk - 1 <= clip.max_x) {
-        for (int j = 0; j < chunks; ++j, c += kChunk, kr += kChunk) {
-          for (int i = 0; i < kChunk; ++i) c[i] = std::max(c[i], kr[i]);
-        }
+      const std::uint8_t* krow = kernel_.data() + static_cast<std::size_t>(k) * stride;
+      std::uint8_t* crow = costs_.data() + static_cast<std::size_t>(y) * sx;
+      if (ax == bx) {
+        stampRow(krow, crow, ax, hw, clip);
         continue;
       }
-      const int n = x1 - x0 + 1;
-      for (int i = 0; i < n; ++i) c[i] = std::max(c[i], kr[i]);
+      // A run: the kernel row's cost only falls with |dx|, so the max over the run's stamps is
+      // the left half of the kernel row up to ax, its centre over the run, the right half from
+      // bx (bytes of one stamp plus the run's length, instead of a stamp per cell).
+      const std::uint8_t centre = krow[r];
+      const int lx0 = std::max(clip.min_x, ax - hw);
+      const int lx1 = std::min(clip.max_x, ax);
+      for (int x = lx0; x <= lx1; ++x) crow[x] = std::max(crow[x], krow[x - ax + r]);
+      const int mx0 = std::max(clip.min_x, ax + 1);
+      const int mx1 = std::min(clip.max_x, bx - 1);
+      for (int x = mx0; x <= mx1; ++x) crow[x] = std::max(crow[x], centre);
+      const int rx0 = std::max(clip.min_x, bx);
+      const int rx1 = std::min(clip.max_x, bx + hw);
+      for (int x = rx0; x <= rx1; ++x) crow[x] = std::max(crow[x], krow[x - bx + r]);
     }
   }
+}
+
+void Inflator::stampRow(const std::uint8_t* krow, std::uint8_t* crow, int cx, int hw,
+                        const CellBounds& clip) const {
+  const int r = radius_cells_;
+  const int x0 = std::max(clip.min_x, cx - hw);
+  const int x1 = std::min(clip.max_x, cx + hw);
+  if (x0 > x1) return;
+  const std::uint8_t* kr = krow + (x0 - cx + r);
+  std::uint8_t* c = crow + x0;
+  // Whole 16-byte chunks where they stay inside the clip: the kernel row is 0 beyond hw (and
+  // padded), so the bytes past the disc take max(c, 0) = c; one vector max per chunk instead of
+  // a loop with a scalar tail for every row of every stamp.
+  const int chunks = (2 * hw + 1 + kChunk - 1) / kChunk;
+  if (x0 == cx - hw && x0 + chunks * kChunk - 1 <= clip.max_x) {
+    for (int j = 0; j < chunks; ++j, c += kChunk, kr += kChunk) {
+      for (int i = 0; i < kChunk; ++i) c[i] = std::max(c[i], kr[i]);
+    }
+    return;
+  }
+  const int n = x1 - x0 + 1;
+  for (int i = 0; i < n; ++i) c[i] = std::max(c[i], kr[i]);
 }
 
 bool Inflator::stampAll(const GridGeometry& g, std::size_t transform_cells, InflationStats* stats) {
@@ -155,16 +191,16 @@ bool Inflator::stampAll(const GridGeometry& g, std::size_t transform_cells, Infl
   all.expand(0, 0);
   all.expand(g.sizeX() - 1, g.sizeY() - 1);
   scratch_.clear();
-  collectBoundary(all, g, &scratch_);
-  const std::size_t boundary = scratch_.size() / 2;
-  if (!preferStamp(boundary, transform_cells)) return false;
+  const std::size_t boundary = collectBoundary(all, g, &scratch_);
+  const std::size_t runs = scratch_.size() / 3;
+  if (!preferStamp(runs, boundary, transform_cells)) return false;
   if (boundary == 0) return true;  // no lethal cell: costs_ is already all 0
   stats->regions = 1;
   stats->regions_stamped = 1;
   stats->cells_recomputed = area(all);
   const std::int32_t* begin = scratch_.data();
   const std::int32_t* end = begin + scratch_.size();
-  if (threads_ < 2 || boundary * stamp_ops_ < kStampThreadMinOps || g.sizeY() < 2) {
+  if (threads_ < 2 || runs * stamp_ops_ < kStampThreadMinOps || g.sizeY() < 2) {
     stampRegion(begin, end, all, g, false);
     return true;
   }
@@ -177,16 +213,16 @@ bool Inflator::stampAll(const GridGeometry& g, std::size_t transform_cells, Infl
   bottom.min_y = mid;
   const auto firstAtRow = [&](int y) {  // first stamp with row >= y
     std::size_t lo = 0;
-    std::size_t hi = boundary;
+    std::size_t hi = runs;
     while (lo < hi) {
       const std::size_t m = (lo + hi) / 2;
-      if (begin[2 * m + 1] < y) {
+      if (begin[3 * m + 2] < y) {
         lo = m + 1;
       } else {
         hi = m;
       }
     }
-    return begin + 2 * lo;
+    return begin + 3 * lo;
   };
   const std::int32_t* bottom_begin = firstAtRow(mid - radius_cells_);
   const std::int32_t* top_end = firstAtRow(mid + radius_cells_);

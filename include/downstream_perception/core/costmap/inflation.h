@@ -137,17 +137,22 @@ class Inflator {
   /// The stamp kernel from the cost table (inflation_stamp.cpp); stamp_ok_ false if the table is
   /// not non-increasing in the distance or the radius is too large.
   void buildKernel();
-  /// Appends (x, y) of every lethal cell in `box` with a non-lethal 4-neighbour in the map (only
-  /// those can be the nearest lethal cell of a non-lethal cell), in row order.
-  void collectBoundary(const CellBounds& box, const GridGeometry& geometry,
-                       std::vector<std::int32_t>* cells) const;
-  /// Estimated cost of stamping `boundary_cells` vs transforming `source_cells`: true if stamping
-  /// is the cheaper (or forced).
-  bool preferStamp(std::size_t boundary_cells, std::size_t source_cells) const;
+  /// Appends every lethal cell in `box` with a non-lethal 4-neighbour in the map (only those can
+  /// be the nearest lethal cell of a non-lethal cell) as runs (x0, x1, y) of consecutive such
+  /// cells in a row, in row order; returns the number of cells.
+  std::size_t collectBoundary(const CellBounds& box, const GridGeometry& geometry,
+                              std::vector<std::int32_t>* runs) const;
+  /// Estimated cost of stamping `runs` runs of `boundary_cells` cells vs transforming
+  /// `source_cells`: true if stamping is the cheaper (or forced).
+  bool preferStamp(std::size_t runs, std::size_t boundary_cells, std::size_t source_cells) const;
   /// costs_ over `clip` = lethal ? 254 : 0 (if `init`; else the caller did that), then
-  /// max-stamps the kernel of the cells [begin, end) of an (x, y) list.
+  /// max-stamps the kernel over the runs [begin, end) of a (x0, x1, y) list.
   void stampRegion(const std::int32_t* begin, const std::int32_t* end, const CellBounds& clip,
                    const GridGeometry& geometry, bool init);
+  /// One kernel row `krow` stamped around column cx (half width hw) into the cost row `crow`,
+  /// clipped to `clip`'s columns.
+  void stampRow(const std::uint8_t* krow, std::uint8_t* crow, int cx, int hw,
+                const CellBounds& clip) const;
   /// The full recompute by stamping (costs_ already lethal ? 254 : 0), rows split over threads_;
   /// false if transforming `transform_cells` source cells would be cheaper.
   bool stampAll(const GridGeometry& geometry, std::size_t transform_cells, InflationStats* stats);
