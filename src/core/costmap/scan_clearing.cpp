@@ -66,39 +66,11 @@ struct ScanCells {
   bool skipsMiss(std::int16_t raw) const {
     return static_cast<bool>((raw & 1) | (raw == saturated_free_raw));
   }
-  /// The miss of a pass-through cell (not skipped); returns whether its state class changed. A
-  /// cell the miss takes to the lower clamp is left unflagged and off the flagged list:
-  /// skipsMiss already skips it for the rest of the scan, every hit came before (pass 1), and a
-  /// further miss could not change it, so the flag would only cost a list entry and a reset (on a
-  /// first scan with a saturating miss, every cell the rays cross).
-  bool miss(std::int16_t* p) const {
-    const int old_v = *p / 2;  // unflagged: raw is even, the division is exact
-    const int v = std::min(hi, std::max(lo, old_v + miss_units));
-    if (v == lo) {
-      *p = static_cast<std::int16_t>(v * 2);
-    } else {
-      *p = static_cast<std::int16_t>(v * 2 + 1);
-      flagged->push_back(static_cast<std::uint32_t>(p - cells));
-    }
-    return stateClass(old_v, free_units, occupied_units) !=
-           stateClass(v, free_units, occupied_units);
-  }
-  /// miss() with its statistics, for the walks off the hot path.
+  /// The miss of a pass-through cell (not skipped).
   void clear(std::int16_t* p) const {
-    if (miss(p)) {
-      const std::size_t i = static_cast<std::size_t>(p - cells);
+    const std::size_t i = static_cast<std::size_t>(p - cells);
+    if (update(i, miss_units)) {
       ++stats->cells_changed;
-      stats->changed.expand(static_cast<int>(i % size_x), static_cast<int>(i / size_x));
-    }
-  }
-  /// Adds the cells a ray changed between `first` and `last` (both changed) to the statistics: x
-  /// and y are monotone along a ray, so the two ends bound them all (two divisions per ray
-  /// instead of two per changed cell).
-  void addChanged(const std::int16_t* first, const std::int16_t* last, std::size_t count) const {
-    if (count == 0) return;
-    stats->cells_changed += count;
-    for (const std::int16_t* p : {first, last}) {
-      const std::size_t i = static_cast<std::size_t>(p - cells);
       stats->changed.expand(static_cast<int>(i % size_x), static_cast<int>(i / size_x));
     }
   }
@@ -150,14 +122,8 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlong(const RayWalk& w
   std::int64_t err = walk.err;
   int left = walk.stepsLeft();
   *walked += static_cast<std::size_t>(left);
-  const std::int16_t* first_changed = nullptr;
-  const std::int16_t* last_changed = nullptr;
-  std::size_t changed = 0;
   for (; left > 0; --left) {
-    if (__builtin_expect(!sc.skipsMiss(*p), 0) && sc.miss(p)) {
-      if (changed++ == 0) first_changed = p;
-      last_changed = p;
-    }
+    if (__builtin_expect(!sc.skipsMiss(*p), 0)) sc.clear(p);
     if (err <= 0) {
       p += dpx;
       err += esx;
@@ -166,7 +132,6 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlong(const RayWalk& w
       err -= esy;
     }
   }
-  sc.addChanged(first_changed, last_changed, changed);
   return p;
 }
 
