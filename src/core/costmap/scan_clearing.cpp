@@ -66,6 +66,34 @@ struct ScanCells {
   bool skipsMiss(std::int16_t raw) const {
     return static_cast<bool>((raw & 1) | (raw == saturated_free_raw));
   }
+  /// The miss of a pass-through cell (not skipped) for the first-visit walk; returns whether its
+  /// state class changed. A cell the miss takes to the lower clamp is left unflagged and off the
+  /// flagged list: skipsMiss already skips it for the rest of the scan, every hit came before
+  /// (pass 1), and a further miss could not change it. (Not in the steady walk: there it measured
+  /// slower, see clearAlongFirstVisits.)
+  bool missFirstVisit(std::int16_t* p) const {
+    const int old_v = *p / 2;  // unflagged: raw is even, the division is exact
+    const int v = std::min(hi, std::max(lo, old_v + miss_units));
+    if (v == lo) {
+      *p = static_cast<std::int16_t>(v * 2);
+    } else {
+      *p = static_cast<std::int16_t>(v * 2 + 1);
+      flagged->push_back(static_cast<std::uint32_t>(p - cells));
+    }
+    return stateClass(old_v, free_units, occupied_units) !=
+           stateClass(v, free_units, occupied_units);
+  }
+  /// Adds the cells a ray changed between `first` and `last` (both changed) to the statistics: x
+  /// and y are monotone along a ray, so the two ends bound them all (two divisions per ray
+  /// instead of two per changed cell).
+  void addChanged(const std::int16_t* first, const std::int16_t* last, std::size_t count) const {
+    if (count == 0) return;
+    stats->cells_changed += count;
+    for (const std::int16_t* p : {first, last}) {
+      const std::size_t i = static_cast<std::size_t>(p - cells);
+      stats->changed.expand(static_cast<int>(i % size_x), static_cast<int>(i / size_x));
+    }
+  }
   /// The miss of a pass-through cell (not skipped).
   void clear(std::int16_t* p) const {
     const std::size_t i = static_cast<std::size_t>(p - cells);
@@ -132,6 +160,42 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlong(const RayWalk& w
       err -= esy;
     }
   }
+  return p;
+}
+
+// clearAlong for a scan over space the grid has hardly seen (ClearingWalk::kFirstVisit): most
+// visits find a cell that still takes a miss, so the miss path is the hot one; it uses
+// missFirstVisit and bounds the changes per ray. Same updates and statistics as clearAlong. In
+// seen space clearAlong is faster (make bench, 360 beams steady: 0.14-0.17 against 0.17-0.20 ms).
+__attribute__((noinline, aligned(64))) std::int16_t* clearAlongFirstVisits(const RayWalk& walk,
+                                                                           std::int16_t* p,
+                                                                           const ScanCells sc,
+                                                                           std::size_t* walked) {
+  if (__builtin_expect(walk.corners, 0)) return clearThroughCorners(walk, p, sc, walked);
+  const std::ptrdiff_t dpx = walk.sx;
+  const std::ptrdiff_t dpy = walk.sy * sc.size_x;
+  const std::int64_t esx = walk.err_step_x;
+  const std::int64_t esy = walk.err_step_y;
+  std::int64_t err = walk.err;
+  int left = walk.stepsLeft();
+  *walked += static_cast<std::size_t>(left);
+  const std::int16_t* first_changed = nullptr;
+  const std::int16_t* last_changed = nullptr;
+  std::size_t changed = 0;
+  for (; left > 0; --left) {
+    if (!sc.skipsMiss(*p) && sc.missFirstVisit(p)) {
+      if (changed++ == 0) first_changed = p;
+      last_changed = p;
+    }
+    if (err <= 0) {
+      p += dpx;
+      err += esx;
+    } else {
+      p += dpy;
+      err -= esy;
+    }
+  }
+  sc.addChanged(first_changed, last_changed, changed);
   return p;
 }
 
@@ -493,6 +557,12 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                           (walk_kind == ClearingWalk::kMarkSweep ||
                            (walk_kind == ClearingWalk::kAuto &&
                             autoChoosesMarkSweep(steps, box_cells, saturated_share)));
+  // The first-visit walk over space the grid has hardly seen, where the mark-sweep does not pay
+  // (sparse rays: the sweep would cost more than the rays).
+  const bool first_visits =
+      !use_blocks && !mark_sweep && !box.empty() &&
+      (walk_kind == ClearingWalk::kFirstVisit ||
+       (walk_kind == ClearingWalk::kAuto && saturated_share < kAutoMinSaturatedShare));
   if (mark_sweep) {
     if (s.crossed.size() != geometry.cellCount()) s.crossed.assign(geometry.cellCount(), 0);
     std::size_t walked = 0;
@@ -533,7 +603,8 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                               walk.err_step_x < kBlockWalkMaxExtent * RayWalk::kOne &&
                               walk.err_step_y < kBlockWalkMaxExtent * RayWalk::kOne
                           ? clearAlongBlocks(walk, start, sc, blocks, &walked)
-                          : clearAlong(walk, start, sc, &walked);
+                          : (first_visits ? clearAlongFirstVisits(walk, start, sc, &walked)
+                                          : clearAlong(walk, start, sc, &walked));
     if (ray.clear_end_cell) {
       ++walked;
       if (!sc.skipsMiss(*p)) sc.clear(p);

@@ -96,6 +96,7 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
   LogOddsGrid per_ray(g, model);
   LogOddsGrid automatic(g, model);
   LogOddsGrid swept(g, model);
+  LogOddsGrid first_visit(g, model);
   std::vector<int> oracle(g.cellCount(), 0);
   IntegrationScratch scratch;  // reused across scans, as the integrator does
   IntegrationScratch auto_scratch;
@@ -125,6 +126,8 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     const IntegrationStats c = integrateBeams(automatic, scan, &auto_scratch, ClearingWalk::kAuto);
     const IntegrationStats d =
         integrateBeams(swept, scan, &sweep_scratch, ClearingWalk::kMarkSweep);
+    const IntegrationStats e =
+        integrateBeams(first_visit, scan, nullptr, ClearingWalk::kFirstVisit);
     const std::vector<int> before = oracle;
     oracleIntegrate(g, per_ray, &oracle, scan);
     // The oracle's statistics: cells whose state class (free / unknown / occupied) changed.
@@ -146,10 +149,13 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     expectSameStats(a, b);
     expectSameStats(c, b);
     expectSameStats(d, b);
+    expectSameStats(e, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(swept.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
+      ASSERT_EQ(first_visit.rawCells()[i], per_ray.rawCells()[i])
+          << "seed " << seed << " scan " << s;
       ASSERT_EQ(blocks.units(i), oracle[i]) << "seed " << seed << " scan " << s << " cell " << i;
     }
   }

@@ -92,6 +92,11 @@ enum class ClearingWalk {
   /// grid has not seen yet (first scan after start-up, a reset or a resize), where the per-ray
   /// walk's load and branch per cell cost ~3x costmap_2d's store; kAuto takes it there.
   kMarkSweep,
+  /// The per-ray walk with its miss path made the fast one: a cell a miss saturates is left
+  /// unflagged (skipped all the same) and changes are bounded per ray. For sparse scans over space
+  /// the grid has hardly seen, where most visits update; kAuto takes it where less than a quarter
+  /// of the box is saturated free and the mark-sweep does not pay.
+  kFirstVisit,
 };
 
 /// ClearingWalk::kAuto's choice, from the rays' cells (steps summed over the rays), the cells of
