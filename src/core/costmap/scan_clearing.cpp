@@ -113,22 +113,29 @@ __attribute__((noinline)) std::int16_t* clearThroughCorners(const RayWalk& walk,
                                                             std::size_t* visited) {
   const std::ptrdiff_t dpx = walk.sx;
   const std::ptrdiff_t dpy = walk.sy * sc.size_x;
+  // The walk's constants and the visit count in locals: the cell stores of clear() could
+  // otherwise make the compiler reload them through `walk` and store the count every cell.
+  const std::int64_t esx = walk.err_step_x;
+  const std::int64_t esy = walk.err_step_y;
+  const std::int64_t tie = walk.tie;
   std::int64_t err = walk.err;
+  std::size_t count = 0;
   for (int left = walk.stepsLeft(); left > 0; --left) {
-    if (!sc.skipsMiss(*p)) sc.clear(p);
-    ++*visited;
-    if (err == walk.tie && left >= 2) {  // both edges of the corner in one step
+    if (__builtin_expect(!sc.skipsMiss(*p), 0)) sc.clear(p);
+    ++count;
+    if (err == tie && left >= 2) {  // both edges of the corner in one step
       p += dpx + dpy;
-      err += walk.err_step_x - walk.err_step_y;
+      err += esx - esy;
       --left;
     } else if (err <= 0) {
       p += dpx;
-      err += walk.err_step_x;
+      err += esx;
     } else {
       p += dpy;
-      err -= walk.err_step_y;
+      err -= esy;
     }
   }
+  *visited += count;
   return p;
 }
 
