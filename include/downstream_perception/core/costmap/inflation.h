@@ -114,7 +114,8 @@ class Inflator {
   InflationStats update(Costmap* master, const CellBounds& window);
 
   /// Threads for a full recompute (1 or 2; default 2 where the machine has them): the band's
-  /// regions split between them, with the same costs bit for bit.
+  /// regions, or the map's two row halves when stamping, split between them, with the same costs
+  /// bit for bit. Only large recomputes use the second thread (a scanned 1000^2 room does not).
   void setThreads(int threads) { threads_ = std::max(1, std::min(2, threads)); }
   int threads() const { return threads_; }
 
