@@ -49,6 +49,16 @@ namespace {
 // (nav_msgs/MapMetaData: 0.1 is 0.100000001490116, so 1.0 m is 9.99999985 cells). 1e-6 is well
 // above float32's relative error (6e-8) and far below any real cell fraction.
 constexpr double kRadiusTolerance = 1e-6;
+
+constexpr int kCompareChunk = 16;
+/// Whether any of kCompareChunk master cells is lethal where `lethal` says not, or the reverse.
+inline bool lethalChanged(const std::uint8_t* master, const std::uint8_t* lethal) {
+  std::uint8_t diff = 0;
+  for (int i = 0; i < kCompareChunk; ++i) {
+    diff |= static_cast<std::uint8_t>((master[i] == cost::kLethalObstacle ? 1 : 0) ^ lethal[i]);
+  }
+  return diff != 0;
+}
 }  // namespace
 
 std::uint8_t inflationCost(double distance_m, const InflationConfig& config) {
@@ -150,6 +160,7 @@ void Inflator::setConfig(const InflationConfig& config, double resolution_m) {
   for (std::int64_t d2 = 0; d2 <= max_d2; ++d2) {
     cost_by_d2_[d2] = inflationCost(std::sqrt(static_cast<double>(d2)) * resolution_m, config);
   }
+  buildKernel();
   full_recompute_ = true;
 }
 
@@ -244,14 +255,22 @@ void Inflator::markDirty(const CellBounds& cells) {
   }
 }
 
-void Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
-  recompute(region, g, &scratch_);
+bool Inflator::recompute(const CellBounds& region, const GridGeometry& g) {
+  return recompute(region, g, &scratch_);
 }
 
-void Inflator::recompute(const CellBounds& region, const GridGeometry& g,
+bool Inflator::recompute(const CellBounds& region, const GridGeometry& g,
                          std::vector<std::int32_t>* scratch) {
-  if (region.empty()) return;
+  if (region.empty()) return false;
   const CellBounds sources = grow(region, radius_cells_, g);
+  if (stamp_ok_ && method_ != InflationMethod::kTransform) {
+    scratch->clear();
+    const std::size_t boundary = collectBoundary(sources, g, scratch);
+    if (preferStamp(scratch->size() / 3, boundary, area(sources))) {
+      stampRegion(scratch->data(), scratch->data() + scratch->size(), region, g, true);
+      return true;
+    }
+  }
   boundedSquaredDistances(lethal_.data(), g.sizeX(), sources, region, radius_cells_, scratch);
   const int w = region.max_x - region.min_x + 1;
   for (int y = region.min_y; y <= region.max_y; ++y) {
@@ -259,6 +278,7 @@ void Inflator::recompute(const CellBounds& region, const GridGeometry& g,
     std::uint8_t* c = costs_.data() + g.index(region.min_x, y);
     for (int x = 0; x < w; ++x) c[x] = costOfSquaredDistance(d2[x]);
   }
+  return false;
 }
 
 void Inflator::recomputeDirtyTiles(const GridGeometry& g, InflationStats* stats) {
@@ -284,13 +304,13 @@ void Inflator::recomputeDirtyTiles(const GridGeometry& g, InflationStats* stats)
       tile = 0;
       if (one_region) continue;
       const CellBounds region = tileCells(tx, ty);
-      recompute(region, g);
+      stats->regions_stamped += recompute(region, g) ? 1 : 0;
       ++stats->regions;
       stats->cells_recomputed += area(region);
     }
   }
   if (one_region) {
-    recompute(merged, g);
+    stats->regions_stamped = recompute(merged, g) ? 1 : 0;
     stats->regions = 1;
     stats->cells_recomputed = area(merged);
   }
@@ -316,7 +336,7 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
     full_recompute_ = false;
   } else {
     for (const CellBounds& region : pending_regions_) {  // edges after a rolling-window shift
-      recompute(region, g);
+      stats.regions_stamped += recompute(region, g) ? 1 : 0;
       ++stats.regions;
       stats.cells_recomputed += area(region);
     }
@@ -326,6 +346,13 @@ InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
     for (int y = w.min_y; !w.empty() && y <= w.max_y; ++y) {
       const std::size_t row = static_cast<std::size_t>(y) * size_x;
       for (int x = w.min_x; x <= w.max_x; ++x) {
+        // 16 cells at a time while nothing changed (one vector compare; almost every chunk of
+        // a steady map).
+        if (x + kCompareChunk <= w.max_x + 1 &&
+            !lethalChanged(m + row + x, lethal_.data() + row + x)) {
+          x += kCompareChunk - 1;
+          continue;
+        }
         const std::uint8_t now = m[row + x] == cost::kLethalObstacle ? 1 : 0;
         if (now == lethal_[row + x]) continue;
         lethal_[row + x] = now;

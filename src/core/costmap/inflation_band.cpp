@@ -10,8 +10,10 @@
 // lethal cell within the radius and gets the cost of "far". A strip is at least 4 radii high, so
 // the sources a region reads beyond its own rows (one radius above and below) cost at most half
 // again. The regions are disjoint, so they split over two threads with no effect on the result.
+// Where lethal cells are sparse enough, stampAll (inflation_stamp.cpp) replaces all of this.
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <thread>
 #include <vector>
 
@@ -21,6 +23,7 @@
 namespace downstream_perception {
 
 using inflation_detail::area;
+using inflation_detail::grow;
 using inflation_detail::kTileShift;
 
 namespace {
@@ -84,40 +87,64 @@ void Inflator::recomputeAll(const std::uint8_t* master, const GridGeometry& g,
   const int tiles_x = (size_x >> kTileShift) + 1;
   const int tiles_y = (size_y >> kTileShift) + 1;
   std::vector<std::uint8_t> lethal_tiles(static_cast<std::size_t>(tiles_x) * tiles_y, 0);
+  // One pass over the master: the lethal set, and the costs every cell starts from (254 on a
+  // lethal cell, the cost of "far" = 0 elsewhere; regions overwrite theirs).
   for (int y = 0; y < size_y; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * size_x;
+    const std::uint8_t* m = master + row;
+    std::uint8_t* l = lethal_.data() + row;
+    std::uint8_t* c = costs_.data() + row;
+    for (int x = 0; x < size_x; ++x) {
+      const bool lethal = m[x] == cost::kLethalObstacle;
+      l[x] = lethal ? 1 : 0;
+      c[x] = lethal ? cost::kLethalObstacle : std::uint8_t{0};
+    }
     std::uint8_t* tiles = lethal_tiles.data() + static_cast<std::size_t>(y >> kTileShift) * tiles_x;
     for (int x0 = 0; x0 < size_x; x0 += kTile) {
+      std::uint8_t& tile = tiles[x0 >> kTileShift];
+      if (tile) continue;
+      // OR of 8-byte words (a byte loop with an early exit does not vectorise: it was most of
+      // this pass).
       const int x1 = std::min(x0 + kTile, size_x);
-      std::uint8_t any = 0;
-      for (int x = x0; x < x1; ++x) {
-        const std::uint8_t l = master[row + x] == cost::kLethalObstacle ? 1 : 0;
-        lethal_[row + x] = l;
-        any |= l;
+      std::uint64_t any = 0;
+      int x = x0;
+      for (; x + 8 <= x1; x += 8) {
+        std::uint64_t word;
+        std::memcpy(&word, l + x, sizeof(word));
+        any |= word;
       }
-      tiles[x0 >> kTileShift] |= any;
+      for (; x < x1; ++x) any |= l[x];
+      tile = any != 0 ? 1 : 0;
     }
   }
-  std::fill(costs_.begin(), costs_.end(), costOfSquaredDistance(kFarSquared));
+  static_assert(cost::kFreeSpace == 0, "cells out of reach start at the cost of far, 0");
   const std::vector<CellBounds> regions = bandRegions(g, lethal_tiles, tiles_x, tiles_y);
+  std::size_t band_sources = 0;  // what the transform would read
+  for (const CellBounds& r : regions) band_sources += area(grow(r, radius_cells_, g));
+  if (stampAll(g, band_sources, stats)) return;  // sparse lethal cells: no transform at all
   std::size_t cells = 0;
   for (const CellBounds& r : regions) cells += area(r);
   stats->regions = regions.size();
   stats->cells_recomputed = cells;
   if (threads_ < 2 || cells < kThreadMinCells || regions.size() < 2) {
-    for (const CellBounds& r : regions) recompute(r, g, &scratch_);
+    for (const CellBounds& r : regions) stats->regions_stamped += recompute(r, g, &scratch_);
     return;
   }
   // Two halves of about equal area, the second on a worker thread (each with its own scratch).
   std::size_t first_cells = 0;
   std::size_t split = 0;
   while (split < regions.size() && 2 * first_cells < cells) first_cells += area(regions[split++]);
+  std::size_t stamped_by_worker = 0;
   std::thread worker([&] {
     std::vector<std::int32_t> scratch;
-    for (std::size_t i = split; i < regions.size(); ++i) recompute(regions[i], g, &scratch);
+    for (std::size_t i = split; i < regions.size(); ++i) {
+      stamped_by_worker += recompute(regions[i], g, &scratch) ? 1 : 0;
+    }
   });
-  for (std::size_t i = 0; i < split; ++i) recompute(regions[i], g, &scratch_);
+  for (std::size_t i = 0; i < split; ++i)
+    stats->regions_stamped += recompute(regions[i], g, &scratch_);
   worker.join();
+  stats->regions_stamped += stamped_by_worker;
 }
 
 }  // namespace downstream_perception

@@ -19,10 +19,12 @@ namespace {
 // raw values: between scans every flag bit is clear, so raw = 2 * units. The loop is
 // compare/select only and vectorises.
 template <bool kWriteUnknown, class Combine>
-void writeRow(const std::int16_t* in, std::uint8_t* dst, int width, int occupied_raw, int free_raw,
-              std::uint8_t unknown_cost, Combine combine) {
+void writeRow(const std::int16_t* in, std::uint8_t* dst, int width, std::int16_t occupied_raw,
+              std::int16_t free_raw, std::uint8_t unknown_cost, Combine combine) {
+  // Compares on int16 (raw values are 2 * units, |units| <= 16383: they fit), so that every
+  // instantiation vectorises.
   for (int x = 0; x < width; ++x) {
-    const int v = in[x];
+    const std::int16_t v = in[x];
     const std::uint8_t old = dst[x];
     const std::uint8_t layer =
         v > occupied_raw ? cost::kLethalObstacle
@@ -44,12 +46,13 @@ std::size_t writeStateCosts(const LogOddsGrid& grid, const CellBounds& window, b
   const GridGeometry& g = grid.geometry();
   const std::int16_t* raw = grid.rawCells();
   std::uint8_t* out = master->data();
-  const int occupied_raw = 2 * grid.occupiedUnits();
-  const int free_raw = 2 * grid.freeUnits();
+  const auto occupied_raw = static_cast<std::int16_t>(2 * grid.occupiedUnits());
+  const auto free_raw = static_cast<std::int16_t>(2 * grid.freeUnits());
   const int width = w.max_x - w.min_x + 1;
   const auto overwrite = [](std::uint8_t, std::uint8_t layer) { return layer; };
   const auto maximum = [](std::uint8_t old, std::uint8_t layer) {
-    return (old == cost::kNoInformation || old < layer) ? layer : old;
+    const std::uint8_t larger = std::max(old, layer);
+    return old == cost::kNoInformation ? layer : larger;  // two selects: vectorises
   };
   for (int y = w.min_y; y <= w.max_y; ++y) {
     const std::size_t row = g.index(w.min_x, y);

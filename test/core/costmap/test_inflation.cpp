@@ -171,6 +171,7 @@ TEST(Inflator, BandRestrictedFullUpdateMatchesTheOracleOnOneAndTwoThreads) {
         Costmap master = map;
         Inflator inflator(c, g.resolution());
         inflator.setThreads(threads);
+        inflator.setMethod(InflationMethod::kTransform);  // the band (kAuto would stamp here)
         const InflationStats stats = inflator.update(&master, everything(g));
         for (std::size_t i = 0; i < g.cellCount(); ++i) {
           ASSERT_EQ(inflator.costs()[i], expected[i])
@@ -441,4 +442,221 @@ TEST(InflationRadius, ACellExactlyOnTheRadiusCountsAtAFloat32Resolution) {
   EXPECT_EQ(map.cost(30, 20), 16);
   EXPECT_EQ(map.cost(20, 10), 16);
   EXPECT_EQ(map.cost(31, 20), 0);
+}
+
+// Issue 20: stamping and the transform are two exact ways to the same bytes. Each test forces
+// one, then the other (and the automatic choice), on maps built to catch a shortcut: lethal cells
+// on and near every edge, filled blocks (interior lethal cells get no stamp), unknown cells,
+// radii of 0, 1 cell, a non-whole number of cells and more than the kernel limit, cost scaling
+// factors from 0 (flat 252) to one that rounds most of the disc to 0, inscribed radius beyond the
+// radius.
+namespace {
+
+Costmap edgeAndBlockMap(const GridGeometry& g, std::mt19937* rng, std::uint8_t background) {
+  Costmap map(g, background);
+  const int sx = g.sizeX();
+  const int sy = g.sizeY();
+  for (const auto& [x, y] : {std::pair<int, int>{0, 0},
+                             {sx - 1, 0},
+                             {0, sy - 1},
+                             {sx - 1, sy - 1},
+                             {sx / 2, 0},
+                             {0, sy / 2},
+                             {sx - 1, sy / 3},
+                             {sx / 3, sy - 1},
+                             {1, 1},
+                             {sx - 2, sy - 2}}) {
+    map.setCost(x, y, cost::kLethalObstacle);
+  }
+  // A filled block and a wall along the bottom edge.
+  for (int y = sy / 3; y < sy / 3 + 7 && y < sy; ++y) {
+    for (int x = sx / 4; x < sx / 4 + 9 && x < sx; ++x) map.setCost(x, y, cost::kLethalObstacle);
+  }
+  for (int x = 3; x < sx - 3; ++x) map.setCost(x, sy - 2, cost::kLethalObstacle);
+  std::bernoulli_distribution lone(0.004);
+  for (int y = 0; y < sy; ++y) {
+    for (int x = 0; x < sx; ++x) {
+      if (lone(*rng)) map.setCost(x, y, cost::kLethalObstacle);
+    }
+  }
+  return map;
+}
+
+InflationStats inflateWith(InflationMethod method, int threads, const InflationConfig& c,
+                           Costmap* map, std::vector<std::uint8_t>* costs) {
+  Inflator inflator(c, map->geometry().resolution());
+  inflator.setMethod(method);
+  inflator.setThreads(threads);
+  const InflationStats stats = inflator.update(map, everything(map->geometry()));
+  *costs = inflator.costs();
+  return stats;
+}
+
+}  // namespace
+
+TEST(InflatorMethods, StampAndTransformEqualTheOracleOnEdgesBlocksAndUnknownCells) {
+  std::mt19937 rng(41);
+  const GridGeometry g(83, 61, 0.05, -0.4, 1.3);
+  struct Case {
+    double radius, csf, inscribed;
+  };
+  const Case cases[] = {{0.0, 10.0, 0.0}, {0.05, 10.0, 0.0},  {0.55, 10.0, 0.25},
+                        {0.33, 0.0, 0.1}, {0.62, 60.0, 0.05}, {0.4, 3.0, 0.6},
+                        {1.3, 2.0, 0.2},  {0.071, 1.0, 0.0}};
+  for (const Case& k : cases) {
+    for (const std::uint8_t background : {cost::kFreeSpace, cost::kNoInformation}) {
+      for (const bool inflate_unknown : {false, true}) {
+        InflationConfig c;
+        c.inflation_radius = k.radius;
+        c.cost_scaling_factor = k.csf;
+        c.inscribed_radius = k.inscribed;
+        c.inflate_unknown = inflate_unknown;
+        const Costmap map = edgeAndBlockMap(g, &rng, background);
+        const auto expected = oracle(map, c);
+        std::vector<std::uint8_t> reference_master;
+        for (const InflationMethod method :
+             {InflationMethod::kTransform, InflationMethod::kStamp, InflationMethod::kAuto}) {
+          for (const int threads : {1, 2}) {
+            Costmap master = map;
+            std::vector<std::uint8_t> costs;
+            const InflationStats stats = inflateWith(method, threads, c, &master, &costs);
+            const std::string what = "radius " + std::to_string(k.radius) + " csf " +
+                                     std::to_string(k.csf) + " method " +
+                                     std::to_string(static_cast<int>(method)) + " threads " +
+                                     std::to_string(threads);
+            ASSERT_EQ(costs, expected) << what;
+            if (reference_master.empty()) reference_master = master.cells();
+            ASSERT_EQ(master.cells(), reference_master) << what;  // same merge, same bytes
+            if (method == InflationMethod::kStamp) {
+              EXPECT_EQ(stats.regions_stamped, 1u) << what;
+            }
+            if (method == InflationMethod::kTransform) {
+              EXPECT_EQ(stats.regions_stamped, 0u) << what;
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(InflatorMethods, StampSplitOverTwoThreadsEqualsOneThreadAndTheTransform) {
+  // Enough stamp work for the second thread (a 1 m radius over 2 % lethal cells), on a map with
+  // an odd number of rows, so the row halves and the stamps that straddle them are exercised.
+  std::mt19937 rng(43);
+  const GridGeometry g(410, 301, 0.05, 0.0, 0.0);
+  const Costmap map = randomLethalMap(g, 0.02, rng);
+  InflationConfig c;
+  c.inflation_radius = 1.0;
+  c.cost_scaling_factor = 3.0;
+  c.inscribed_radius = 0.2;
+  std::vector<std::uint8_t> transform, one, two;
+  Costmap m0 = map, m1 = map, m2 = map;
+  inflateWith(InflationMethod::kTransform, 1, c, &m0, &transform);
+  inflateWith(InflationMethod::kStamp, 1, c, &m1, &one);
+  inflateWith(InflationMethod::kStamp, 2, c, &m2, &two);
+  ASSERT_EQ(one, transform);
+  ASSERT_EQ(two, transform);
+  ASSERT_EQ(m2.cells(), m0.cells());
+  // Spot check against the oracle's formula: cell (0, 0)'s nearest lethal cell by brute force.
+  long best = -1;
+  for (int y = 0; y < 25; ++y) {
+    for (int x = 0; x < 25; ++x) {
+      if (map.cost(x, y) != cost::kLethalObstacle) continue;
+      const long d2 = static_cast<long>(x) * x + static_cast<long>(y) * y;
+      if (best < 0 || d2 < best) best = d2;
+    }
+  }
+  const std::uint8_t at_origin =
+      best < 0 ? 0 : inflationCost(std::sqrt(static_cast<double>(best)) * 0.05, c);
+  EXPECT_EQ(two[0], at_origin);
+}
+
+TEST(InflatorMethods, RadiusBeyondTheKernelLimitFallsBackToTheExactTransform) {
+  // 300 cells > kMaxStampRadiusCells: no kernel; kStamp must still give exact costs.
+  const GridGeometry g(70, 40, 0.05, 0.0, 0.0);
+  Costmap map(g, cost::kFreeSpace);
+  map.setCost(3, 5, cost::kLethalObstacle);
+  map.setCost(69, 39, cost::kLethalObstacle);
+  InflationConfig c;
+  c.inflation_radius = 15.0;  // 300 cells
+  c.cost_scaling_factor = 0.5;
+  ASSERT_GT(15.0 / 0.05, Inflator::kMaxStampRadiusCells);
+  const auto expected = oracle(map, c);
+  for (const InflationMethod method : {InflationMethod::kStamp, InflationMethod::kAuto}) {
+    Costmap master = map;
+    std::vector<std::uint8_t> costs;
+    const InflationStats stats = inflateWith(method, 1, c, &master, &costs);
+    ASSERT_EQ(costs, expected);
+    EXPECT_EQ(stats.regions_stamped, 0u);
+  }
+}
+
+TEST(InflatorMethods, AutoStampsSparseMapsAndTransformsDenseOnes) {
+  std::mt19937 rng(47);
+  const GridGeometry g(300, 200, 0.05, 0.0, 0.0);
+  InflationConfig c;
+  c.inflation_radius = 1.0;
+  std::vector<std::uint8_t> costs;
+  Costmap sparse = randomLethalMap(g, 0.001, rng);
+  EXPECT_EQ(inflateWith(InflationMethod::kAuto, 1, c, &sparse, &costs).regions_stamped, 1u);
+  // Half the cells lethal at random: nearly all of them boundary cells, each a 41-row stamp.
+  Costmap dense = randomLethalMap(g, 0.5, rng);
+  const auto expected = oracle(dense, c);
+  EXPECT_EQ(inflateWith(InflationMethod::kAuto, 1, c, &dense, &costs).regions_stamped, 0u);
+  ASSERT_EQ(costs, expected);
+}
+
+TEST(InflatorMethods, IncrementalAndRollingUpdatesEqualFullRecomputationWithEitherMethod) {
+  std::mt19937 rng(53);
+  const GridGeometry g(130, 95, 0.05, 0.0, 0.0);
+  for (const InflationMethod method : {InflationMethod::kStamp, InflationMethod::kTransform}) {
+    for (const double radius : {0.05, 0.55, 1.2}) {
+      InflationConfig c;
+      c.inflation_radius = radius;
+      c.inscribed_radius = 0.15;
+      Costmap truth = edgeAndBlockMap(g, &rng, cost::kFreeSpace);
+      Costmap master = truth;
+      Inflator inflator(c, g.resolution());
+      inflator.setMethod(method);
+      inflator.update(&master, everything(g));
+      std::uniform_int_distribution<int> ux(0, g.sizeX() - 1), uy(0, g.sizeY() - 1);
+      for (int step = 0; step < 30; ++step) {
+        CellBounds changed;
+        const int x0 = ux(rng), y0 = uy(rng);
+        for (int y = y0; y <= std::min(g.sizeY() - 1, y0 + 6); ++y) {
+          for (int x = x0; x <= std::min(g.sizeX() - 1, x0 + 9); ++x) {
+            truth.setCost(x, y, rng() % 3 == 0 ? cost::kLethalObstacle : cost::kFreeSpace);
+            changed.expand(x, y);
+          }
+        }
+        CellBounds window = changed;
+        window.min_x -= inflator.radiusCells();
+        window.min_y -= inflator.radiusCells();
+        window.max_x += inflator.radiusCells();
+        window.max_y += inflator.radiusCells();
+        window = master.clamp(window);
+        for (int y = window.min_y; y <= window.max_y; ++y) {
+          for (int x = window.min_x; x <= window.max_x; ++x) master.setCost(x, y, truth.cost(x, y));
+        }
+        inflator.update(&master, window);
+      }
+      ASSERT_EQ(inflator.costs(), oracle(truth, c))
+          << "radius " << radius << " method " << static_cast<int>(method);
+      // A shift: the edge bands go through the same method.
+      master.shift(3, -2);
+      inflator.shift(3, -2);
+      Costmap moved(master.geometry(), cost::kFreeSpace);
+      for (int y = 0; y < g.sizeY(); ++y) {
+        for (int x = 0; x < g.sizeX(); ++x) {
+          const int wx = x + 3, wy = y - 2;
+          if (wx < g.sizeX() && wy >= 0) moved.setCost(x, y, truth.cost(wx, wy));
+        }
+      }
+      master = moved;
+      inflator.update(&master, everything(master.geometry()));
+      ASSERT_EQ(inflator.costs(), oracle(moved, c))
+          << "after shift, radius " << radius << " method " << static_cast<int>(method);
+    }
+  }
 }

@@ -80,3 +80,66 @@ TEST(LogOddsCosts, MaximumCombinationOnlyRaisesCosts) {
   EXPECT_TRUE(validateCombinationMethod(1).empty());
   EXPECT_FALSE(validateCombinationMethod(99).empty());
 }
+
+// The row loop works on int16 raw values and selects (so that it vectorises): every combination of
+// write_unknown and combination method against a per-cell statement of the rule, on a random
+// master (free, lethal, unknown, anything) and log-odds up to the int16 extremes, in windows whose
+// rows are longer than a vector and end in a partial one.
+TEST(WriteStateCosts, EveryVariantMatchesThePerCellRule) {
+  const GridGeometry g(67, 19, 0.05, 0.0, 0.0);
+  LogOddsConfig wide;
+  wide.clamp_min = -LogOddsGrid::kMaxLogOdds;
+  wide.clamp_max = LogOddsGrid::kMaxLogOdds;
+  LogOddsGrid grid(g, wide);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> l(-LogOddsGrid::kMaxLogOdds, LogOddsGrid::kMaxLogOdds);
+  std::uniform_int_distribution<int> pick(0, 9);
+  for (std::size_t i = 0; i < g.cellCount(); ++i) {
+    const int k = pick(rng);  // some cells exactly on a threshold or at the extremes
+    grid.setLogOdds(i, k == 0   ? wide.occupied_threshold
+                       : k == 1 ? wide.free_threshold
+                       : k == 2 ? LogOddsGrid::kMaxLogOdds
+                       : k == 3 ? -LogOddsGrid::kMaxLogOdds
+                                : l(rng));
+  }
+  Costmap start(g, 0);
+  std::uniform_int_distribution<int> any(0, 255);
+  for (int y = 0; y < g.sizeY(); ++y) {
+    for (int x = 0; x < g.sizeX(); ++x) {
+      const int k = pick(rng);
+      start.setCost(x, y,
+                    k < 2   ? cost::kNoInformation
+                    : k < 4 ? cost::kFreeSpace
+                    : k < 5 ? cost::kLethalObstacle
+                            : static_cast<std::uint8_t>(any(rng)));
+    }
+  }
+  CellBounds window;
+  window.expand(3, 2);
+  window.expand(61, 17);
+  for (const bool write_unknown : {false, true}) {
+    for (const CombinationMethod method :
+         {CombinationMethod::kOverwrite, CombinationMethod::kMaximum}) {
+      Costmap master = start;
+      writeStateCosts(grid, window, write_unknown, 77, &master, method);
+      for (int y = 0; y < g.sizeY(); ++y) {
+        for (int x = 0; x < g.sizeX(); ++x) {
+          const std::uint8_t old = start.cost(x, y);
+          std::uint8_t expected = old;
+          const CellState s = grid.state(g.index(x, y));
+          const bool inside = x >= 3 && x <= 61 && y >= 2 && y <= 17;
+          if (inside && (s != CellState::kUnknown || write_unknown)) {
+            const std::uint8_t layer = s == CellState::kOccupied ? cost::kLethalObstacle
+                                       : s == CellState::kFree   ? cost::kFreeSpace
+                                                                 : std::uint8_t{77};
+            expected = method == CombinationMethod::kOverwrite        ? layer
+                       : (old == cost::kNoInformation || layer > old) ? layer
+                                                                      : old;
+          }
+          ASSERT_EQ(master.cost(x, y), expected) << x << "," << y << " unknown " << write_unknown
+                                                 << " method " << static_cast<int>(method);
+        }
+      }
+    }
+  }
+}

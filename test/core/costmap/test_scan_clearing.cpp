@@ -97,11 +97,16 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
   LogOddsGrid automatic(g, model);
   LogOddsGrid threaded(g, model);
   LogOddsGrid threaded_per_ray(g, model);
+  LogOddsGrid threaded_first_visit(g, model);
+  LogOddsGrid swept(g, model);
+  LogOddsGrid first_visit(g, model);
   std::vector<int> oracle(g.cellCount(), 0);
   IntegrationScratch scratch;  // reused across scans, as the integrator does
   IntegrationScratch auto_scratch;
   IntegrationScratch threaded_scratch;
   IntegrationScratch threaded_per_ray_scratch;
+  IntegrationScratch threaded_first_visit_scratch;
+  IntegrationScratch sweep_scratch;
   const double w = g.sizeX() * g.resolution();
   const double h = g.sizeY() * g.resolution();
   std::uniform_real_distribution<double> ux(g.originX() - 0.1 * w, g.originX() + 1.1 * w);
@@ -125,21 +130,52 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     const IntegrationStats a = integrateBeams(blocks, scan, &scratch, ClearingWalk::kBlockSkip);
     const IntegrationStats b = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
     const IntegrationStats c = integrateBeams(automatic, scan, &auto_scratch, ClearingWalk::kAuto);
-    // Two threads from the first ray cell on (the default waits for 100,000).
+    // Two threads from the first ray cell on (the default waits for 200,000).
     const IntegrationStats d =
         integrateBeams(threaded, scan, &threaded_scratch, ClearingWalk::kBlockSkip, 2, 0);
     const IntegrationStats e = integrateBeams(threaded_per_ray, scan, &threaded_per_ray_scratch,
                                               ClearingWalk::kPerRay, 2, 0);
+    const IntegrationStats f = integrateBeams(
+        threaded_first_visit, scan, &threaded_first_visit_scratch, ClearingWalk::kFirstVisit, 2, 0);
+    const IntegrationStats g_swept =
+        integrateBeams(swept, scan, &sweep_scratch, ClearingWalk::kMarkSweep);
+    const IntegrationStats h_first =
+        integrateBeams(first_visit, scan, nullptr, ClearingWalk::kFirstVisit);
+    const std::vector<int> before = oracle;
     oracleIntegrate(g, per_ray, &oracle, scan);
+    // The oracle's statistics: cells whose state class (free / unknown / occupied) changed.
+    std::size_t changed = 0;
+    CellBounds changed_box;
+    const auto cls = [&](int v) {
+      return (v > per_ray.occupiedUnits()) - (v < per_ray.freeUnits());
+    };
+    for (std::size_t i = 0; i < g.cellCount(); ++i) {
+      if (cls(before[i]) == cls(oracle[i])) continue;
+      ++changed;
+      changed_box.expand(static_cast<int>(i % g.sizeX()), static_cast<int>(i / g.sizeX()));
+    }
+    EXPECT_EQ(b.cells_changed, changed) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.min_x, changed_box.min_x) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.max_x, changed_box.max_x) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.min_y, changed_box.min_y) << "seed " << seed << " scan " << s;
+    EXPECT_EQ(b.changed.max_y, changed_box.max_y) << "seed " << seed << " scan " << s;
     expectSameStats(a, b);
     expectSameStats(c, b);
     expectSameStats(d, b);
     expectSameStats(e, b);
+    expectSameStats(f, b);
+    expectSameStats(g_swept, b);
+    expectSameStats(h_first, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(threaded.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(threaded_per_ray.rawCells()[i], per_ray.rawCells()[i])
+          << "seed " << seed << " scan " << s;
+      ASSERT_EQ(threaded_first_visit.rawCells()[i], per_ray.rawCells()[i])
+          << "seed " << seed << " scan " << s;
+      ASSERT_EQ(swept.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
+      ASSERT_EQ(first_visit.rawCells()[i], per_ray.rawCells()[i])
           << "seed " << seed << " scan " << s;
       ASSERT_EQ(blocks.units(i), oracle[i]) << "seed " << seed << " scan " << s << " cell " << i;
     }
@@ -165,6 +201,26 @@ TEST(ScanClearing, DenseScansSaturateAndStillMatch) {
   const GridGeometry g(200, 170, 0.05, -4.3, -4.1);
   compareWalks(77, g, 40, 3600, false);
   compareWalks(78, g, 10, 3600, true);
+}
+
+TEST(ScanClearing, SaturatingMissesMatchTheOracle) {
+  // A binary-like model (one miss takes a cell to the lower clamp, one hit marks it): the walk
+  // leaves such cells unflagged, so later rays of the same scan must still skip them, hits must
+  // still win over misses, and the next scan must update them again. Against the oracle, with
+  // its statistics, on first scans (all unknown) and on repeated dense ones.
+  LogOddsConfig binary;
+  binary.p_hit = 0.99;
+  binary.p_miss = 0.01;
+  binary.clamp_min = -2.1;
+  binary.clamp_max = 2.1;
+  compareWalks(91, GridGeometry(120, 90, 0.05, -2.9, -2.1), 12, 720, false, binary);
+  compareWalks(92, GridGeometry(200, 170, 0.05, -4.3, -4.1), 8, 3600, true, binary);
+  // A miss that reaches the clamp only from some values: -0.9 per miss against a clamp of -2.
+  LogOddsConfig partial;
+  partial.p_miss = 0.29;
+  partial.clamp_min = -2.05;
+  partial.free_threshold = -1.0;
+  compareWalks(93, GridGeometry(90, 110, 0.1, 0.3, -1.7), 20, 500, false, partial);
 }
 
 TEST(ScanClearing, AxisAlignedAndSingleCellRays) {
@@ -248,8 +304,10 @@ TEST(ScanClearing, TwoThreadsSplitTheRaysAtABlockRow) {
   IntegrationScratch two_scratch;
   for (int s = 0; s < 8; ++s) {
     const auto scan = randomScan(&rng, 0.013 + 0.2 * s, -0.31, 3600, 9.0);
-    const IntegrationStats a = integrateBeams(one, scan, &one_scratch, ClearingWalk::kAuto, 1);
-    const IntegrationStats b = integrateBeams(two, scan, &two_scratch, ClearingWalk::kAuto, 2, 0);
+    // The block walk (kAuto takes the single-threaded mark-sweep for a first dense scan).
+    const IntegrationStats a = integrateBeams(one, scan, &one_scratch, ClearingWalk::kBlockSkip, 1);
+    const IntegrationStats b =
+        integrateBeams(two, scan, &two_scratch, ClearingWalk::kBlockSkip, 2, 0);
     expectSameStats(a, b);
     ASSERT_GE(two_scratch.bands.size(), 3u);
     std::size_t parts = 0;
@@ -327,4 +385,20 @@ TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
   CellIndex wall;
   ASSERT_TRUE(g.worldToCell(half_x + 0.001, 0.3, &wall));
   EXPECT_EQ(per_ray.state(g.index(wall.x, wall.y)), CellState::kOccupied);
+}
+
+TEST(ScanClearing, AutoTakesMarkSweepForDenseRaysOverUnseenSpace) {
+  // Rays crossing at least half the box's cells over a box less than a quarter saturated.
+  EXPECT_TRUE(autoChoosesMarkSweep(500, 1000, 0.0));
+  EXPECT_TRUE(autoChoosesMarkSweep(2000, 1000, 0.24));
+  EXPECT_FALSE(autoChoosesMarkSweep(499, 1000, 0.0));    // sparse: the sweep would cost more
+  EXPECT_FALSE(autoChoosesMarkSweep(2000, 1000, 0.25));  // seen space: the block walk's case
+  // A first dense scan on a real grid takes it, and its marks are all cleared afterwards.
+  const GridGeometry g(300, 260, 0.05, -7.5, -6.5);
+  LogOddsGrid grid(g);
+  IntegrationScratch scratch;
+  std::mt19937 rng(5);
+  integrateBeams(grid, randomScan(&rng, 0.01, 0.02, 3600, 7.0), &scratch, ClearingWalk::kAuto);
+  ASSERT_EQ(scratch.crossed.size(), g.cellCount());
+  for (const std::uint8_t mark : scratch.crossed) ASSERT_EQ(mark, 0);
 }

@@ -13,6 +13,12 @@
 // is off in about 1 cell in 16,000; a full OpenCV distance transform would be exact too, but costs
 // O(map) per update and float distances.)
 //
+// Two exact ways to the same costs (src/core/costmap/inflation_stamp.cpp): where lethal cells
+// are sparse, each lethal cell on the boundary of the lethal set stamps a precomputed disc of
+// costs with max(); the cost only falls with distance, so the max over the stamps is the cost of
+// the nearest lethal cell, bit for bit what the transform gives. Where lethal cells are dense the
+// transform is cheaper; a cost estimate picks per region (InflationMethod::kAuto).
+//
 // Incremental: the Inflator keeps the set of lethal cells it last saw and the inflation costs
 // they produce. Each update compares the master's lethal cells inside the update window with that
 // set; only cells within the inflation radius of a changed lethal cell are recomputed (from the
@@ -62,11 +68,19 @@ void boundedSquaredDistances(const std::uint8_t* lethal, int stride, const CellB
                              const CellBounds& out_box, int max_distance_cells,
                              std::vector<std::int32_t>* out);
 
+/// How the Inflator computes a region's costs; both are exact and give the same bytes.
+enum class InflationMethod {
+  kAuto,       ///< per region, whichever the cost estimate says is cheaper
+  kStamp,      ///< max-stamp a cost disc per boundary lethal cell (if the table allows it)
+  kTransform,  ///< the bounded distance transform
+};
+
 struct InflationStats {
   std::size_t lethal_changed = 0;    ///< cells that became or stopped being lethal
   std::size_t cells_recomputed = 0;  ///< cells whose distance was recomputed
   std::size_t regions = 0;           ///< distance-transform regions run
   std::size_t cells_merged = 0;      ///< cells merged into the master
+  std::size_t regions_stamped = 0;   ///< regions computed by stamping (the rest: transform)
 };
 
 class Inflator {
@@ -100,18 +114,49 @@ class Inflator {
   InflationStats update(Costmap* master, const CellBounds& window);
 
   /// Threads for a full recompute (1 or 2; default 2 where the machine has them): the band's
-  /// regions split between them, with the same costs bit for bit.
+  /// regions, or the map's two row halves when stamping, split between them, with the same costs
+  /// bit for bit. Only large recomputes use the second thread (a scanned 1000^2 room does not).
   void setThreads(int threads) { threads_ = std::max(1, std::min(2, threads)); }
   int threads() const { return threads_; }
+
+  /// Forces one way of computing costs (tests, benchmarks); kAuto by default. kStamp falls back to
+  /// the transform when the cost table is not monotone or the radius exceeds kMaxStampRadiusCells.
+  void setMethod(InflationMethod method) { method_ = method; }
+  InflationMethod method() const { return method_; }
+  /// Largest radius (cells) with a stamp kernel: (2r + 1)^2 bytes, 263 kB at 256.
+  static constexpr int kMaxStampRadiusCells = 256;
 
   /// Cached inflation cost per cell (as if no cell were unknown), for tests and Python.
   const std::vector<std::uint8_t>& costs() const { return costs_; }
 
  private:
   void resizeTo(const GridGeometry& geometry);
-  void recompute(const CellBounds& region, const GridGeometry& geometry);
-  void recompute(const CellBounds& region, const GridGeometry& geometry,
+  bool recompute(const CellBounds& region, const GridGeometry& geometry);
+  /// Returns true if the region was stamped (false: transform).
+  bool recompute(const CellBounds& region, const GridGeometry& geometry,
                  std::vector<std::int32_t>* scratch);
+  /// The stamp kernel from the cost table (inflation_stamp.cpp); stamp_ok_ false if the table is
+  /// not non-increasing in the distance or the radius is too large.
+  void buildKernel();
+  /// Appends every lethal cell in `box` with a non-lethal 4-neighbour in the map (only those can
+  /// be the nearest lethal cell of a non-lethal cell) as runs (x0, x1, y) of consecutive such
+  /// cells in a row, in row order; returns the number of cells.
+  std::size_t collectBoundary(const CellBounds& box, const GridGeometry& geometry,
+                              std::vector<std::int32_t>* runs) const;
+  /// Estimated cost of stamping `runs` runs of `boundary_cells` cells vs transforming
+  /// `source_cells`: true if stamping is the cheaper (or forced).
+  bool preferStamp(std::size_t runs, std::size_t boundary_cells, std::size_t source_cells) const;
+  /// costs_ over `clip` = lethal ? 254 : 0 (if `init`; else the caller did that), then
+  /// max-stamps the kernel over the runs [begin, end) of a (x0, x1, y) list.
+  void stampRegion(const std::int32_t* begin, const std::int32_t* end, const CellBounds& clip,
+                   const GridGeometry& geometry, bool init);
+  /// One kernel row `krow` stamped around column cx (half width hw) into the cost row `crow`,
+  /// clipped to `clip`'s columns.
+  void stampRow(const std::uint8_t* krow, std::uint8_t* crow, int cx, int hw,
+                const CellBounds& clip) const;
+  /// The full recompute by stamping (costs_ already lethal ? 254 : 0), rows split over threads_;
+  /// false if transforming `transform_cells` source cells would be cheaper.
+  bool stampAll(const GridGeometry& geometry, std::size_t transform_cells, InflationStats* stats);
   /// The whole cache from the master: lethal cells, then the band within the radius of them
   /// (src/core/costmap/inflation_band.cpp).
   void recomputeAll(const std::uint8_t* master, const GridGeometry& geometry,
@@ -129,6 +174,13 @@ class Inflator {
   double resolution_ = 0.0;
   int radius_cells_ = 0;
   std::vector<std::uint8_t> cost_by_d2_;  ///< cost for squared distance 0 .. radius^2
+  std::vector<std::uint8_t> kernel_;  ///< (2r+1) rows of costs around a lethal cell, zero-padded
+  /// Bytes per kernel row: 2r+1 costs and 16 zeros, so a stamp can read whole 16-byte chunks.
+  std::size_t kernelStride() const { return static_cast<std::size_t>(2 * radius_cells_ + 17); }
+  std::vector<int> kernel_half_width_;  ///< per kernel row: largest |dx| with a cost > 0, or -1
+  std::size_t stamp_ops_ = 0;           ///< estimated work of one stamp (vector ops + rows)
+  bool stamp_ok_ = false;
+  InflationMethod method_ = InflationMethod::kAuto;
   GridGeometry geometry_;
   std::vector<std::uint8_t> lethal_;  ///< 1 where the master was lethal at the last update
   std::vector<std::uint8_t> costs_;

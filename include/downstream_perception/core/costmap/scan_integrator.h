@@ -87,6 +87,18 @@ enum class ClearingWalk {
   /// exact integer jump instead of cell by cell. Near the sensor, where the beams of a dense
   /// scan overlap, most of every ray crosses such blocks.
   kBlockSkip,
+  /// Mark, then sweep: the rays only mark the cells they cross in a byte map (a store per cell,
+  /// no load, as costmap_2d's raytrace), then one pass over the rays' box gives every marked cell
+  /// its one miss and clears the marks. Each crossed cell takes exactly one miss either way, so
+  /// the grid and statistics are those of the per-ray walk. Pays on a dense scan over space the
+  /// grid has not seen yet (first scan after start-up, a reset or a resize), where the per-ray
+  /// walk's load and branch per cell cost ~3x costmap_2d's store; kAuto takes it there.
+  kMarkSweep,
+  /// The per-ray walk with its miss path made the fast one: a cell a miss saturates is left
+  /// unflagged (skipped all the same) and changes are bounded per ray. For sparse scans over space
+  /// the grid has hardly seen, where most visits update; kAuto takes it where less than a quarter
+  /// of the box is saturated free and the mark-sweep does not pay.
+  kFirstVisit,
 };
 
 /// ClearingWalk::kAuto's choice, from the rays' cells (steps summed over the rays), the cells of
@@ -94,6 +106,10 @@ enum class ClearingWalk {
 /// walk when the rays cross the box more than once over and at least a quarter of it is
 /// saturated (else no block could be skipped: a first scan).
 bool autoChoosesBlockWalk(std::size_t ray_cells, std::size_t box_cells,
+                          double saturated_free_share);
+/// ClearingWalk::kAuto's choice of the mark-sweep walk (when it does not take the block walk):
+/// the rays cross at least half the box's cells and less than a quarter of it is saturated free.
+bool autoChoosesMarkSweep(std::size_t ray_cells, std::size_t box_cells,
                           double saturated_free_share);
 
 /// One clearing ray of a scan, set up before any is walked.
@@ -109,7 +125,9 @@ struct IntegrationScratch {
   std::vector<std::int32_t> block_pending;  ///< per block: -1 unchecked, else cells left to clear
   std::vector<std::uint32_t> block_masks;   ///< per block: where those cells are
   std::vector<std::uint32_t> blocks_checked;
-  int blocks_x = 0;  ///< block_pending's layout (blocks per row)
+  std::vector<std::uint8_t> crossed;  ///< mark-sweep: 1 where a ray crossed (all 0 between scans)
+  std::vector<std::uint8_t> row_changed;  ///< mark-sweep: per cell of a row, state class changed
+  int blocks_x = 0;                       ///< block_pending's layout (blocks per row)
   int blocks_y = 0;
   /// The banded walk (see integrateBeams): each band's ray parts, flags, blocks and results.
   struct Band {
