@@ -81,6 +81,9 @@ class VoxelLayerTest(unittest.TestCase):
     def test_stvl_keys_outside_an_stvl_configuration_are_unknown(self) -> None:
         # The layer's type is ours, not STVL's: STVL's keys are not adopted, so they are warned
         # as unknown keys (compatibility rule: no key is ignored silently).
+        if not rospy.has_param("/costmap/voxels/voxel_decay"):
+            self.skipTest("this launch's configuration has no STVL key")
+
         def warned(key: str) -> bool:
             with self.lock:
                 return any(f"{key} is not a key" in w for w in self.warnings)
