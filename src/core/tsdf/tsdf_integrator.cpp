@@ -260,9 +260,10 @@ DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, boo
 /// How deep behind its surface (m) a guarded pixel still updates voxels, into f->allowed: a
 /// voxel divided by the cosine of the incidence angle (between the ray and the surface normal,
 /// estimated from the neighbours along the row and the column nearest in depth), at most
-/// `max_voxels` voxels. At grazing incidence a voxel just under the surface lies several voxels
-/// behind it along the ray; without this the faces seen edge-on next to an object's rim (a box
-/// top seen from a little above it) got no "inside" values at all and no surface.
+/// `max_voxels` voxels; a voxel at the rim pixels themselves (the seeds in f->edge). At grazing
+/// incidence a voxel just under the surface lies several voxels behind it along the ray; without
+/// this the faces seen edge-on next to an object's rim (a box top seen from a little above it) got
+/// no "inside" values at all and no surface.
 DP_INTEGRATION_STEP void guardDepths(const PinholeCamera& cam, float s, float jump,
                                      float max_voxels, DepthFrame* f) {
   const int w = cam.width, h = cam.height;
@@ -281,7 +282,8 @@ DP_INTEGRATION_STEP void guardDepths(const PinholeCamera& cam, float s, float ju
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * w + u;
-      if (!f->near_edge[i] || inv[i] == 0.0f) continue;
+      // Not at the rim itself (a seed): its ray is the one that leaves the object again.
+      if (!f->near_edge[i] || f->edge[i] || inv[i] == 0.0f) continue;
       const Eigen::Vector3f p = ray(u, v) * dep[i];
       // The tangent towards the neighbour (either side) nearest in depth, within `jump`.
       const auto tangent = [&](int du, int dv, Eigen::Vector3f* t) {

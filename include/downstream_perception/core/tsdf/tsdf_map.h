@@ -52,11 +52,12 @@ struct TsdfConfig {
   /// surface like any other. false: both sides and every pixel within edge_guard_rad (the guard
   /// before issue 22's defect 4: it cost surface seen only next to objects).
   bool edge_guard_near_side_only = true;
-  /// Edge guard: a guarded pixel still updates voxels up to voxel_size_m / cos(incidence) behind
-  /// its surface (incidence: between the ray and the surface normal estimated from the
-  /// neighbouring pixels), at most this many voxels. At grazing incidence a voxel just under
-  /// the surface lies several voxels behind it along the ray, so a face seen edge-on next to a
-  /// rim (a box top seen from a little above) got no surface. 1 = a voxel at any incidence.
+  /// Edge guard: a guarded pixel other than the rim pixels themselves still updates voxels up to
+  /// voxel_size_m / cos(incidence) behind its surface (incidence: between the ray and the surface
+  /// normal estimated from the neighbouring pixels), at most this many voxels. At grazing incidence
+  /// a voxel just under the surface lies several voxels behind it along the ray, so a face seen
+  /// edge-on next to a rim (a box top seen from a little above) got no surface. 1 = a voxel at any
+  /// incidence.
   double edge_guard_grazing_voxels = 2.0;
   /// Depth images: read each voxel's depth by interpolating inverse depth between the four
   /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
