@@ -411,7 +411,7 @@ class TsdfConfig:
     @property
     def edge_guard_grazing_voxels(self) -> float:
         """
-        Edge guard: a guarded pixel still updates voxels up to voxel_size_m / cos(incidence) behind its surface, at most this many voxels (a face seen edge-on next to a rim needs them); 1 = a voxel at any incidence.
+        Edge guard: a guarded pixel beside the rim (not the rim pixel itself) still updates voxels up to voxel_size_m / cos(incidence) behind its surface, at most this many voxels (a face seen edge-on next to a rim needs them); 1 = a voxel at any incidence.
         """
     @edge_guard_grazing_voxels.setter
     def edge_guard_grazing_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...

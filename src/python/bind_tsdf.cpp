@@ -239,7 +239,8 @@ void bindTsdf(py::module& m) {
                      "guarded, and only pixels at most mu farther than the rim; false: both "
                      "sides and every pixel within edge_guard_rad (the guard before).")
       .def_readwrite("edge_guard_grazing_voxels", &TsdfConfig::edge_guard_grazing_voxels,
-                     "Edge guard: a guarded pixel still updates voxels up to voxel_size_m / "
+                     "Edge guard: a guarded pixel beside the rim (not the rim pixel itself) still "
+                     "updates voxels up to voxel_size_m / "
                      "cos(incidence) behind its surface, at most this many voxels (a face seen "
                      "edge-on next to a rim needs them); 1 = a voxel at any incidence.")
       .def_readwrite(
