@@ -20,7 +20,8 @@ voxel off every surface) and completeness (observed surface within 2 cm of the m
 writes every score.
 
 Usage: make bench-tsdf-accuracy   (or: python3 bench/bench_tsdf_accuracy.py [--quick]; --quick: a
-half-size 320x240 camera (same field of view), 5 cm, 2 scenes, 2 offsets, 8 frames)
+half-size 320x240 camera (same field of view), 5 cm, 2 scenes, 2 offsets, 8 frames; subsets:
+--scenes, --configs, --noises, --offsets)
 """
 
 from __future__ import annotations
@@ -233,7 +234,7 @@ def run(
     log: Callable[[str], None] = print,
 ) -> list[Score]:
     from downstream_perception.sim.depth_camera import DepthCamera
-    from downstream_perception.sim.scenes import accuracy_scene
+    from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
     from downstream_perception.tsdf_eval import observed_samples
 
     chosen = integrators(edge_guards)
@@ -241,20 +242,23 @@ def run(
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
         cam = scaled(cameras[image], camera_scale)
-        for si, scene_name in enumerate(scenes):
+        for scene_name in scenes:
+            # Seeds from the full lists' indices, so a subset gets the full run's frames.
+            si = list(ACCURACY_SCENES).index(scene_name)
             # Scene and cameras move together, so the images and the observed surface (moved
             # along) are the same at every offset: rendered once.
             base, base_poses = accuracy_scene(scene_name, (0.0, 0.0, 0.0), frames)
             clean = [cam.render(base, T) for T in base_poses]
             base_observed = observed_samples(base, cam, base_poses, clean)
             for voxel in [v for i, v in configs if i == image]:
-                for oi, fraction in enumerate(offsets):
+                for fraction in offsets:
+                    oi = offset_index(fraction)
                     t0 = time.perf_counter()
                     offset = (fraction * voxel,) * 3
                     scene, poses = accuracy_scene(scene_name, offset, frames)
                     observed = base_observed + np.asarray(offset)
                     for noise in noises:
-                        depths, at = noisy_frames(clean, poses, noise, seed=1000 * si + 10 * oi)
+                        depths, at = noisy_frames(clean, poses, noise, seed=case_seed(si, oi))
                         for name, integrate in chosen.items():
                             row = score_case(integrate, scene, cam, depths, at, voxel, observed)
                             scores.append(
@@ -269,6 +273,17 @@ def run(
                         f"{time.perf_counter() - t0:.1f} s"
                     )
     return scores
+
+
+def case_seed(scene_index: int, offset_index: int) -> int:
+    return 1000 * scene_index + 10 * offset_index
+
+
+def offset_index(fraction: float) -> int:
+    """The offset's index in OFFSET_FRACTIONS (others after them, by value), for the seed."""
+    if fraction in OFFSET_FRACTIONS:
+        return OFFSET_FRACTIONS.index(fraction)
+    return len(OFFSET_FRACTIONS) + round(1000 * fraction)
 
 
 def scaled(cam: Any, scale: float) -> Any:
@@ -350,6 +365,11 @@ def main() -> None:
         default=str(DEFAULT_EDGE_GUARD_RAD),
         help="comma-separated edge_guard_rad values for ours (rad; 0 = off)",
     )
+    parser.add_argument(
+        "--offsets",
+        default=",".join(f"{f:g}" for f in OFFSET_FRACTIONS),
+        help="comma-separated lattice offsets, fractions of a voxel (for a quicker subset)",
+    )
     parser.add_argument("--json", type=Path, help="write every score here")
     args = parser.parse_args()
     scenes = [s for s in args.scenes.split(",") if s]
@@ -363,7 +383,8 @@ def main() -> None:
     if args.noises != "all":
         noises = [NOISES[int(i)] for i in args.noises.split(",")]
     edge_guards = [float(v) for v in args.edge_guard.split(",")]
-    frames, offsets, scale = 30, OFFSET_FRACTIONS, 1.0
+    frames, scale = 30, 1.0
+    offsets = tuple(float(f) for f in args.offsets.split(",") if f)
     if args.quick:
         scenes, configs, frames = scenes[:2], [("320x240", 0.05)], 8
         offsets, scale = (0.0, 0.5), 0.5

@@ -231,7 +231,18 @@ void bindTsdf(py::module& m) {
                      "within this angle (rad) of a depth edge (a jump of more than mu) are not "
                      "updated. Rays grazing an object's rim would otherwise write \"inside\" "
                      "values into the free space beyond its edges (the projective TSDF's ghost "
-                     "surfaces). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.")
+                     "surfaces). A depth edge: neighbouring pixels more than mu apart in depth "
+                     "(or one invalid) that do not continue one plane. 0.0075 rad is 2 pixels "
+                     "at f = 262, 4 at f = 525; 0 disables.")
+      .def_readwrite("edge_guard_near_side_only", &TsdfConfig::edge_guard_near_side_only,
+                     "Edge guard: only the nearer side of a depth edge (the object's rim) is "
+                     "guarded, and only pixels at most mu farther than the rim; false: both "
+                     "sides and every pixel within edge_guard_rad (the guard before).")
+      .def_readwrite("edge_guard_grazing_voxels", &TsdfConfig::edge_guard_grazing_voxels,
+                     "Edge guard: a guarded pixel beside the rim (not the rim pixel itself) still "
+                     "updates voxels up to voxel_size_m / "
+                     "cos(incidence) behind its surface, at most this many voxels (a face seen "
+                     "edge-on next to a rim needs them); 1 = a voxel at any incidence.")
       .def_readwrite(
           "interpolate_depth", &TsdfConfig::interpolate_depth,
           "Depth images: read each voxel's depth by interpolating inverse depth between the four "

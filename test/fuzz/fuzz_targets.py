@@ -1258,6 +1258,8 @@ def tsdf_config_args(g: Gen) -> dict[str, Any]:
         "max_weight": g.f(10, 100, 0.1),
         "behind_surface_dropoff": g.b(),
         "edge_guard_rad": g.f(0, 0.01, 0.1),
+        "edge_guard_near_side_only": g.b(),
+        "edge_guard_grazing_voxels": g.f(1, 4, 0.1),
         "interpolate_depth": g.b(),
         "carve_free_space": g.chance(0.3),
         "min_depth_m": g.f(0.05, 0.3, 0.1),

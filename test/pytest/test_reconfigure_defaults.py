@@ -135,6 +135,8 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "max_weight",
         "behind_surface_dropoff",
         "edge_guard_rad",
+        "edge_guard_near_side_only",
+        "edge_guard_grazing_voxels",
         "interpolate_depth",
         "carve_free_space",
         "no_return_carve_min_valid_fraction",

@@ -94,12 +94,16 @@ struct DepthFrame {
   /// when they change.
   std::vector<float> range_per_depth;
   PinholeCamera camera;  ///< the intrinsics range_per_depth was computed for
-  /// Pixels within edge_guard_rad of a depth edge (a jump of more than mu between neighbours, or
-  /// an invalid neighbour): what lies behind them is not known to be behind a surface. Empty
-  /// when the guard is off.
+  /// Pixels within edge_guard_rad of a depth discontinuity (markNearEdges): what lies behind
+  /// them is not known to be behind a surface. Empty when the guard is off.
   std::vector<std::uint8_t> near_edge;
-  std::vector<std::uint8_t> edge;  ///< scratch: the edges before dilation
-  std::vector<std::uint8_t> rows;  ///< scratch: the edges dilated along rows
+  /// Per pixel, how deep behind its surface (m) voxels are updated when it is near_edge
+  /// (guardDepths). Empty when the guard is off.
+  std::vector<float> allowed;
+  std::vector<std::uint8_t> edge;  ///< scratch: the discontinuities' seeds
+  std::vector<std::uint8_t> rows;  ///< scratch: the seeds dilated along rows
+  std::vector<float> seed_depth;   ///< scratch: the seeds' depths, then their window minimum
+  std::vector<float> rows_depth;   ///< scratch: the seeds' depths' minimum along rows
   /// 1 where the 2 x 2 pixels from this one (right, down) are all valid depths within a voxel
   /// of each other: inverse depth may be interpolated between them. Checked once per pixel here
   /// instead of once per voxel in the integration loop (empty without interpolate_depth).
@@ -125,42 +129,23 @@ void computeRangePerDepth(const PinholeCamera& camera, DepthFrame* f) {
   f->camera = camera;
 }
 
-/// Marks pixels next to a depth jump of more than `jump` (m) or to an invalid pixel, then
-/// dilates the marks by `radius` pixels (a separable box). Every pass is a plain loop without
-/// branches, which the compiler vectorises.
-DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, DepthFrame* f) {
-  const std::size_t n = static_cast<std::size_t>(w) * h;
-  f->edge.resize(n);
-  f->rows.resize(n);
-  f->near_edge.resize(n);
-  const float* inv = f->inverse.data();
-  const float* dep = f->depth.data();
-  std::uint8_t* edge = f->edge.data();
-  // A neighbour differs when it is invalid (NaN, +Inf: the compare below is false for both)
-  // or more than `jump` away in depth.
-  const auto differs = [&](std::size_t j, float d) { return !(std::abs(dep[j] - d) <= jump); };
-  const auto borderPixel = [&](int u, int v) {
-    const std::size_t i = static_cast<std::size_t>(v) * w + u;
-    const float d = dep[i];
-    edge[i] = inv[i] != 0.0f && ((u + 1 < w && differs(i + 1, d)) || (u > 0 && differs(i - 1, d)) ||
-                                 (v + 1 < h && differs(i + w, d)) || (v > 0 && differs(i - w, d)));
-  };
-  for (int v = 0; v < h; ++v) {
-    if (v == 0 || v + 1 == h) {
-      for (int u = 0; u < w; ++u) borderPixel(u, v);
-      continue;
-    }
-    borderPixel(0, v);
-    for (int u = 1; u + 1 < w; ++u) {
-      const std::size_t i = static_cast<std::size_t>(v) * w + u;
-      const float d = dep[i];
-      edge[i] = (inv[i] != 0.0f) &
-                (differs(i + 1, d) | differs(i - 1, d) | differs(i + w, d) | differs(i - w, d));
-    }
-    if (w > 1) borderPixel(w - 1, v);
-  }
-  // Dilation along rows, then columns: each output is the OR of its window, the first term
-  // assigned (so the buffers need no clearing), the others ORed in.
+/// Whether neighbouring pixels a = i - step, i, j = i + step, b = j + step lie on one plane
+/// within `tol` (m), judged from either side: on a plane inverse depth is affine along an image
+/// line, so 2 / d_i - 1 / d_a predicts 1 / d_j (and 2 / d_j - 1 / d_b predicts 1 / d_i). A zero
+/// inverse depth (invalid pixel, or none outside the image) predicts nothing.
+DP_INTEGRATION_STEP bool onOnePlane(float inv_a, float inv_i, float inv_j, float inv_b, float d_i,
+                                    float d_j, float tol) {
+  const float p_j = 2.0f * inv_i - inv_a;
+  const float p_i = 2.0f * inv_j - inv_b;
+  const bool from_i = (inv_a != 0.0f) & (p_j > 0.0f) & (std::abs(d_j * p_j - 1.0f) <= tol * p_j);
+  const bool from_j = (inv_b != 0.0f) & (p_i > 0.0f) & (std::abs(d_i * p_i - 1.0f) <= tol * p_i);
+  return from_i | from_j;
+}
+
+/// Dilates `edge` (w x h bytes) by `radius` pixels (a separable box) into f->near_edge: each
+/// output is the OR of its window, the first term assigned (so the buffers need no clearing).
+DP_INTEGRATION_STEP void dilateEdges(int w, int h, int radius, DepthFrame* f) {
+  const std::uint8_t* edge = f->edge.data();
   for (int v = 0; v < h; ++v) {
     const std::uint8_t* src = edge + static_cast<std::size_t>(v) * w;
     std::uint8_t* dst = f->rows.data() + static_cast<std::size_t>(v) * w;
@@ -180,6 +165,149 @@ DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, Dep
     for (int k = v0 + 1; k <= v1; ++k) {
       const std::uint8_t* src = rows + static_cast<std::size_t>(k) * w;
       for (int u = 0; u < w; ++u) dst[u] |= src[u];
+    }
+  }
+}
+
+/// Spreads the edge seeds by `radius` pixels into f->near_edge, but only to pixels at most
+/// `jump` (m) farther than the nearest seed in their window (a separable minimum filter of the
+/// seeds' depths): the object beside its rim, not the background beside the object.
+DP_INTEGRATION_STEP void spreadOverNearSide(int w, int h, float jump, int radius, DepthFrame* f) {
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::uint8_t* edge = f->edge.data();
+  const float* dep = f->depth.data();
+  f->seed_depth.resize(n);
+  f->rows_depth.resize(n);
+  float* seed = f->seed_depth.data();
+  for (std::size_t i = 0; i < n; ++i) seed[i] = edge[i] ? dep[i] : inf;
+  for (int v = 0; v < h; ++v) {
+    const float* src = seed + static_cast<std::size_t>(v) * w;
+    float* dst = f->rows_depth.data() + static_cast<std::size_t>(v) * w;
+    for (int u = 0; u < w; ++u) dst[u] = src[u];
+    for (int k = 1; k <= radius && k < w; ++k) {
+      for (int u = 0; u + k < w; ++u) dst[u] = std::min(dst[u], src[u + k]);
+      for (int u = k; u < w; ++u) dst[u] = std::min(dst[u], src[u - k]);
+    }
+  }
+  // Column pass into seed (no longer needed as seeds), then the test against the depth.
+  const float* rows = f->rows_depth.data();
+  for (int v = 0; v < h; ++v) {
+    float* dst = seed + static_cast<std::size_t>(v) * w;
+    const int v0 = std::max(0, v - radius), v1 = std::min(h - 1, v + radius);
+    const float* first = rows + static_cast<std::size_t>(v0) * w;
+    for (int u = 0; u < w; ++u) dst[u] = first[u];
+    for (int k = v0 + 1; k <= v1; ++k) {
+      const float* src = rows + static_cast<std::size_t>(k) * w;
+      for (int u = 0; u < w; ++u) dst[u] = std::min(dst[u], src[u]);
+    }
+  }
+  std::uint8_t* out = f->near_edge.data();
+  // NaN depths (invalid) fail the compare; +Inf ones too (an infinite seed is no seed).
+  for (std::size_t i = 0; i < n; ++i) out[i] = (seed[i] != inf) & (dep[i] <= seed[i] + jump);
+}
+
+/// The edge guard's mask f->near_edge. Two neighbouring pixels (along a row or a column) are a
+/// depth discontinuity when one is not a valid depth (NaN, +Inf) or their depths differ by more
+/// than `jump` (m) and they are not onOnePlane within jump / 2 (a surface seen at a grazing angle
+/// far away steps by more than mu from pixel to pixel, but continues its neighbours' plane: no
+/// rim there). near_side_only: the nearer pixel of a discontinuity (the valid one next to an
+/// invalid one) is a seed, spread by `radius` pixels only over pixels not more than `jump`
+/// farther (spreadOverNearSide); else both pixels are seeds, spread to every pixel within
+/// `radius` (the guard before issue 22's defect 4).
+DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, bool near_side_only,
+                                       DepthFrame* f) {
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  f->edge.assign(n, 0);
+  f->rows.resize(n);
+  f->near_edge.resize(n);
+  const float* inv = f->inverse.data();
+  const float* dep = f->depth.data();
+  std::uint8_t* edge = f->edge.data();
+  const float tol = 0.5f * jump;
+  // The pair (i, i + step); has_a / has_b: whether i - step and i + 2 step are in the image.
+  const auto pair = [&](std::size_t i, std::size_t step, bool has_a, bool has_b) {
+    const std::size_t j = i + step;
+    const float di = dep[i], dj = dep[j];
+    const bool vi = inv[i] != 0.0f, vj = inv[j] != 0.0f;
+    if (std::abs(dj - di) <= jump) return;  // false for NaN and +Inf: they differ
+    const float inv_a = has_a ? inv[i - step] : 0.0f;
+    const float inv_b = has_b ? inv[j + step] : 0.0f;
+    if (vi & vj && onOnePlane(inv_a, inv[i], inv[j], inv_b, di, dj, tol)) return;
+    if (near_side_only) {
+      edge[i] |= vi & (!vj | (dj > di));
+      edge[j] |= vj & (!vi | (di > dj));
+    } else {
+      edge[i] |= vi;
+      edge[j] |= vj;
+    }
+  };
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u + 1 < w; ++u) pair(static_cast<std::size_t>(v) * w + u, 1, u > 0, u + 2 < w);
+  }
+  for (int v = 0; v + 1 < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      pair(static_cast<std::size_t>(v) * w + u, static_cast<std::size_t>(w), v > 0, v + 2 < h);
+    }
+  }
+  if (near_side_only) {
+    spreadOverNearSide(w, h, jump, radius, f);
+  } else {
+    dilateEdges(w, h, radius, f);
+  }
+}
+
+/// How deep behind its surface (m) a guarded pixel still updates voxels, into f->allowed: a
+/// voxel divided by the cosine of the incidence angle (between the ray and the surface normal,
+/// estimated from the neighbours along the row and the column nearest in depth), at most
+/// `max_voxels` voxels; a voxel at the rim pixels themselves (the seeds in f->edge). At grazing
+/// incidence a voxel just under the surface lies several voxels behind it along the ray; without
+/// this the faces seen edge-on next to an object's rim (a box top seen from a little above it) got
+/// no "inside" values at all and no surface.
+DP_INTEGRATION_STEP void guardDepths(const PinholeCamera& cam, float s, float jump,
+                                     float max_voxels, DepthFrame* f) {
+  const int w = cam.width, h = cam.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  f->allowed.assign(n, s);
+  if (!(max_voxels > 1.0f)) return;
+  const float min_cos = 1.0f / max_voxels;
+  const float* dep = f->depth.data();
+  const float* inv = f->inverse.data();
+  const float inv_fx = static_cast<float>(1.0 / cam.fx), inv_fy = static_cast<float>(1.0 / cam.fy);
+  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+  const auto ray = [&](int u, int v) {
+    return Eigen::Vector3f((static_cast<float>(u) - cx) * inv_fx,
+                           (static_cast<float>(v) - cy) * inv_fy, 1.0f);
+  };
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      // Not at the rim itself (a seed): its ray is the one that leaves the object again.
+      if (!f->near_edge[i] || f->edge[i] || inv[i] == 0.0f) continue;
+      const Eigen::Vector3f p = ray(u, v) * dep[i];
+      // The tangent towards the neighbour (either side) nearest in depth, within `jump`.
+      const auto tangent = [&](int du, int dv, Eigen::Vector3f* t) {
+        float best = jump;
+        bool found = false;
+        for (const int sign : {-1, 1}) {
+          const int uu = u + sign * du, vv = v + sign * dv;
+          if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+          const std::size_t j = static_cast<std::size_t>(vv) * w + uu;
+          const float diff = std::abs(dep[j] - dep[i]);
+          if (inv[j] == 0.0f || !(diff <= best)) continue;
+          best = diff;
+          *t = ray(uu, vv) * dep[j] - p;
+          found = true;
+        }
+        return found;
+      };
+      Eigen::Vector3f tu, tv;
+      if (!tangent(1, 0, &tu) || !tangent(0, 1, &tv)) continue;
+      const Eigen::Vector3f normal = tu.cross(tv);
+      const float norms = normal.norm() * p.norm();
+      if (!(norms > 0.0f)) continue;
+      const float cosine = std::abs(normal.dot(p)) / norms;
+      f->allowed[i] = s / std::max(cosine, min_cos);
     }
   }
 }
@@ -258,9 +386,13 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   const int radius =
       static_cast<int>(std::ceil(c.edge_guard_rad * std::max(camera.fx, camera.fy) - 1e-9));
   if (radius > 0) {
-    markNearEdges(w, h, static_cast<float>(c.truncation()), radius, &f);
+    markNearEdges(w, h, static_cast<float>(c.truncation()), radius, c.edge_guard_near_side_only,
+                  &f);
+    guardDepths(camera, static_cast<float>(c.voxel_size_m), static_cast<float>(c.truncation()),
+                static_cast<float>(c.edge_guard_grazing_voxels), &f);
   } else {
     f.near_edge.clear();
+    f.allowed.clear();
   }
 }
 
@@ -432,6 +564,8 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
   alignas(32) float i00[kTsdfBlockSide] = {}, i10[kTsdfBlockSide] = {}, i01[kTsdfBlockSide] = {},
                     i11[kTsdfBlockSide] = {};
   alignas(32) int flags[kTsdfBlockSide] = {};  // bit 0: interpolate, bit 1: near an edge
+  alignas(32) float allowed[kTsdfBlockSide] = {};
+  const float* allowed_px = frame.allowed.data();
   // The blocks are found (or allocated) first, so each block's integration can prefetch the
   // next block's voxels: blocks lie scattered in memory, where the hardware prefetcher does not
   // follow.
@@ -499,6 +633,7 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
           if (!(along_axis <= muf + max_step)) continue;  // in front: free space
           range[x] = range_px[px];
           int flag = guard ? edge_px[px] << 1 : 0;
+          allowed[x] = guard ? allowed_px[px] : sf;
           if (interpolate) {
             const float* inv = inverse_px + cell[x];
             i00[x] = inv[0];
@@ -535,8 +670,9 @@ DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera
               (along_axis >= -muf - max_step) &
               !(no_return & (z_axis > max_z)) &  // no return: free only up to max_depth_m
               !(in_band & (sdf < -muf)) &
-              // Behind a depth edge the ray grazed an object's rim: no evidence of "inside".
-              !(in_band & (sdf < -sf) & ((flags[x] & 2) != 0));
+              // Behind an object's rim the ray may have left the object again: no evidence of
+              // "inside" deeper than the guard allows (a voxel, more at grazing incidence).
+              !(in_band & (sdf < -allowed[x]) & ((flags[x] & 2) != 0));
           const float dn = std::min(1.0f, sdf * inv_mu);
           const float obs_w = weight(no_return ? z_axis : nearest[x], sdf);
           TsdfVoxel& voxel = row_voxels[x];

@@ -27,6 +27,8 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   pnh.param("no_return_carve_min_valid_fraction", c.no_return_carve_min_valid_fraction,
             c.no_return_carve_min_valid_fraction);
   pnh.param("edge_guard_rad", c.edge_guard_rad, c.edge_guard_rad);
+  pnh.param("edge_guard_near_side_only", c.edge_guard_near_side_only, c.edge_guard_near_side_only);
+  pnh.param("edge_guard_grazing_voxels", c.edge_guard_grazing_voxels, c.edge_guard_grazing_voxels);
   pnh.param("min_depth_m", c.min_depth_m, c.min_depth_m);
   pnh.param("max_depth_m", c.max_depth_m, c.max_depth_m);
   pnh.param("min_weight", c.min_weight, c.min_weight);

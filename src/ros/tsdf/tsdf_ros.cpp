@@ -126,6 +126,8 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.max_weight = cfg.max_weight;
   next.behind_surface_dropoff = cfg.behind_surface_dropoff;
   next.edge_guard_rad = cfg.edge_guard_rad;
+  next.edge_guard_near_side_only = cfg.edge_guard_near_side_only;
+  next.edge_guard_grazing_voxels = cfg.edge_guard_grazing_voxels;
   next.interpolate_depth = cfg.interpolate_depth;
   next.carve_free_space = cfg.carve_free_space;
   next.no_return_carve_min_valid_fraction = cfg.no_return_carve_min_valid_fraction;

@@ -40,10 +40,25 @@ struct TsdfConfig {
   /// the other side (voxblox's weight drop-off).
   bool behind_surface_dropoff = true;
   /// Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle
-  /// (rad) of a depth edge (a jump of more than mu) are not updated. Rays grazing an object's rim
-  /// would otherwise write "inside" values into the free space beyond its edges (the projective
-  /// TSDF's ghost surfaces). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.
+  /// (rad) of a depth edge are not updated. Rays grazing an object's rim would otherwise write
+  /// "inside" values into the free space beyond its edges (the projective TSDF's ghost
+  /// surfaces). A depth edge: neighbouring pixels more than mu apart in depth (or one invalid)
+  /// that do not continue one plane (a surface seen at a grazing angle far away steps by more
+  /// than mu per pixel without an edge). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525;
+  /// 0 disables.
   double edge_guard_rad = 0.0075;
+  /// Edge guard: only the nearer side of a depth edge (the object's rim) is guarded, and only
+  /// pixels at most mu farther than the rim; the background beside an object is behind a
+  /// surface like any other. false: both sides and every pixel within edge_guard_rad (the guard
+  /// before issue 22's defect 4: it cost surface seen only next to objects).
+  bool edge_guard_near_side_only = true;
+  /// Edge guard: a guarded pixel other than the rim pixels themselves still updates voxels up to
+  /// voxel_size_m / cos(incidence) behind its surface (incidence: between the ray and the surface
+  /// normal estimated from the neighbouring pixels), at most this many voxels. At grazing incidence
+  /// a voxel just under the surface lies several voxels behind it along the ray, so a face seen
+  /// edge-on next to a rim (a box top seen from a little above) got no surface. 1 = a voxel at any
+  /// incidence.
+  double edge_guard_grazing_voxels = 2.0;
   /// Depth images: read each voxel's depth by interpolating inverse depth between the four
   /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
   /// nearest pixel across depth edges (neighbours differing by more than one voxel).
