@@ -414,7 +414,9 @@ class TsdfConfig:
         Edge guard: a guarded pixel beside the rim (not the rim pixel itself) still updates voxels up to voxel_size_m / cos(incidence) behind its surface, at most this many voxels (a face seen edge-on next to a rim needs them); 1 = a voxel at any incidence.
         """
     @edge_guard_grazing_voxels.setter
-    def edge_guard_grazing_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    def edge_guard_grazing_voxels(
+        self, arg0: typing.SupportsFloat | typing.SupportsIndex
+    ) -> None: ...
     @property
     def edge_guard_near_side_only(self) -> bool:
         """
@@ -425,7 +427,7 @@ class TsdfConfig:
     @property
     def edge_guard_rad(self) -> float:
         """
-        Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle (rad) of a depth edge are not updated. Rays grazing an object's rim would otherwise write "inside" values into the free space beyond its edges (the projective TSDF's ghost surfaces). A depth edge: neighbouring pixels more than mu apart in depth (or one invalid) that do not continue one plane. 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.
+        Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle (rad) of a depth edge (a jump of more than mu) are not updated. Rays grazing an object's rim would otherwise write "inside" values into the free space beyond its edges (the projective TSDF's ghost surfaces). A depth edge: neighbouring pixels more than mu apart in depth (or one invalid) that do not continue one plane. 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.
         """
     @edge_guard_rad.setter
     def edge_guard_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
