@@ -490,6 +490,72 @@ inline void blockExit(std::int64_t err, std::int64_t esx, std::int64_t esy, int 
   }
 }
 
+__extension__ typedef __int128 Int128;  // GCC/Clang; __extension__: not ISO C++ (-Wpedantic)
+
+// From the walk's state (x, y, err, left, p) in a block it leaves in one jump (nx, ny: its x and
+// y steps to the block's far edges), follows the blocks the walk enters next, without its cells:
+// the nx-th x crossing comes before the ny-th y crossing exactly when err + (nx - 1) esx -
+// (ny - 1) esy <= 0 (blockExit's rule), and that sum moves by a block's esx or esy per block, so
+// each block costs an add and its pending count (blockExit's division only where a block with
+// changeable cells is entered, for the walk's exact state there). Returns false when the ray ends
+// in a block with none (the caller goes to the end cell); else the state at the first cell of the
+// first block that has some. No overflow: the sum stays within about a block's step of 0 (below
+// 2^61 for the block walk's rays), and the exact state is computed in 128 bits.
+inline bool crossCleanBlocks(const RayWalk& walk, const ScanCells& sc, const Blocks& blocks, int nx,
+                             int ny, int* x, int* y, std::int64_t* err, int* left,
+                             std::int16_t** p) {
+  const std::int64_t esx = walk.err_step_x;
+  const std::int64_t esy = walk.err_step_y;
+  const int end_bx = walk.endX() >> kBlockShift;
+  const int end_by = walk.endY() >> kBlockShift;
+  int bx = *x >> kBlockShift;
+  int by = *y >> kBlockShift;
+  std::int64_t next_a = nx;  // x steps from (x, y) to the first cell beyond the next x edge
+  std::int64_t next_b = ny;
+  std::int64_t order = *err + (next_a - 1) * esx - (next_b - 1) * esy;
+  for (;;) {
+    std::int64_t a = -1;  // steps from (x, y) to the first cell of the block entered: the one
+    std::int64_t b = -1;  // along the crossing axis now, the other one below if needed
+    if (order <= 0) {
+      a = next_a;
+      bx += walk.sx;
+      next_a += kBlock;
+      order += kBlock * esx;
+    } else {
+      b = next_b;
+      by += walk.sy;
+      next_b += kBlock;
+      order -= kBlock * esy;
+    }
+    // Never past the end block (exact arithmetic never gets there; a guard, not a case).
+    if ((bx - end_bx) * walk.sx > 0 || (by - end_by) * walk.sy > 0) return false;
+    const std::uint32_t block = static_cast<std::uint32_t>(by) * blocks.blocks_x + bx;
+    std::int32_t* pending = blocks.pending + block;
+    if (*pending < 0) {
+      *pending = countPending(sc, blocks.size_y, bx, by, blocks.masks + block * kMasksPerBlock);
+      blocks.checked->push_back(block);
+    }
+    if (*pending == 0) {
+      if (bx == end_bx && by == end_by) return false;
+      continue;
+    }
+    if (a >= 0) {  // entered across an x edge: the y steps before the a-th x step
+      const Int128 num = static_cast<Int128>(*err) + static_cast<Int128>(a - 1) * esx;
+      b = num <= 0 ? 0 : static_cast<std::int64_t>((num + esy - 1) / esy);
+    } else {  // across a y edge: the x steps before the b-th y step
+      const Int128 num = static_cast<Int128>(b - 1) * esy - *err;
+      a = num < 0 ? 0 : static_cast<std::int64_t>(num / esx + 1);
+    }
+    *x += walk.sx * static_cast<int>(a);
+    *y += walk.sy * static_cast<int>(b);
+    *err = static_cast<std::int64_t>(static_cast<Int128>(*err) + static_cast<Int128>(a) * esx -
+                                     static_cast<Int128>(b) * esy);
+    *left -= static_cast<int>(a + b);
+    *p += a * walk.sx + b * walk.sy * sc.size_x;
+    return true;
+  }
+}
+
 // The walk of clearAlong (no corners) block by block: a block with no pending cell is crossed in
 // one jump; in the others every cell is visited, and each cell cleared counts down its block.
 // Rays longer than 2^15 cells per axis take clearAlong instead (the caller checks), which keeps
@@ -550,15 +616,12 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlongBlocks(const RayW
                            offset(last_y, by));
     }
     if (jump) {
-      // Every cell the walk would visit here is a no-op: cross the block in one jump.
-      if (steps >= left) {  // the ray ends in (or just past) this block: go to its end
+      // Every cell the walk would visit here is a no-op: cross the block, and every clean block
+      // after it, without visiting a cell.
+      if (steps >= left ||  // the ray ends in (or just past) this block
+          !crossCleanBlocks(walk, sc, blocks, nx, ny, &x, &y, &err, &left, &p)) {
         return sc.cells + static_cast<std::ptrdiff_t>(walk.endY()) * sc.size_x + walk.endX();
       }
-      p += tx * dpx + ty * dpy;
-      err += tx * esx - ty * esy;
-      x += walk.sx * tx;
-      y += walk.sy * ty;
-      left -= steps;
       continue;
     }
     // Visit the block's cells cell by cell until the walk leaves the block (its block index
@@ -622,8 +685,6 @@ std::size_t walkRays(const std::vector<ClearingRay>& rays, const ScanCells& sc,
 // Bands of a dense scan's walk shared between two threads: four, so that the claiming evens out
 // the band estimate's error (each thread takes about two).
 constexpr int kScanBands = 4;
-
-__extension__ typedef __int128 Int128;  // GCC/Clang; __extension__: not ISO C++ (-Wpedantic)
 
 void splitAtRow(const RayWalk& walk, int row, RayWalk* prefix, RayWalk* suffix) {
   const int b = walk.sy > 0 ? row - walk.cy : walk.cy - row;
