@@ -490,6 +490,18 @@ inline void blockExit(std::int64_t err, std::int64_t esx, std::int64_t esy, int 
   }
 }
 
+// The count of block (bx, by)'s changeable cells, counted (with its masks) when the scan first
+// enters the block.
+inline std::int32_t* blockPending(const ScanCells& sc, const Blocks& blocks, int bx, int by) {
+  const std::uint32_t b = static_cast<std::uint32_t>(by) * blocks.blocks_x + bx;
+  std::int32_t* pending = blocks.pending + b;
+  if (*pending < 0) {
+    *pending = countPending(sc, blocks.size_y, bx, by, blocks.masks + b * kMasksPerBlock);
+    blocks.checked->push_back(b);
+  }
+  return pending;
+}
+
 __extension__ typedef __int128 Int128;  // GCC/Clang; __extension__: not ISO C++ (-Wpedantic)
 
 // From the walk's state (x, y, err, left, p) in a block it leaves in one jump (nx, ny: its x and
@@ -529,13 +541,7 @@ inline bool crossCleanBlocks(const RayWalk& walk, const ScanCells& sc, const Blo
     }
     // Never past the end block (exact arithmetic never gets there; a guard, not a case).
     if ((bx - end_bx) * walk.sx > 0 || (by - end_by) * walk.sy > 0) return false;
-    const std::uint32_t block = static_cast<std::uint32_t>(by) * blocks.blocks_x + bx;
-    std::int32_t* pending = blocks.pending + block;
-    if (*pending < 0) {
-      *pending = countPending(sc, blocks.size_y, bx, by, blocks.masks + block * kMasksPerBlock);
-      blocks.checked->push_back(block);
-    }
-    if (*pending == 0) {
+    if (*blockPending(sc, blocks, bx, by) == 0) {
       if (bx == end_bx && by == end_by) return false;
       continue;
     }
@@ -578,11 +584,7 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlongBlocks(const RayW
     const int bx = x >> kBlockShift;
     const int by = y >> kBlockShift;
     const std::uint32_t b = static_cast<std::uint32_t>(by) * blocks.blocks_x + bx;
-    std::int32_t* pending = blocks.pending + b;
-    if (*pending < 0) {
-      *pending = countPending(sc, blocks.size_y, bx, by, blocks.masks + b * kMasksPerBlock);
-      blocks.checked->push_back(b);
-    }
+    std::int32_t* const pending = blockPending(sc, blocks, bx, by);
     // Where the walk leaves the block (blockExit: the only place the walk divides).
     const int ox = x & (kBlock - 1);
     const int oy = y & (kBlock - 1);
@@ -609,11 +611,9 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlongBlocks(const RayW
         last_x = walk.endX() - (last_step_x ? walk.sx : 0);
         last_y = walk.endY() - (last_step_x ? 0 : walk.sy);
       }
-      const auto offset = [](int v, int block) {
-        return std::min(kBlock - 1, std::max(0, v - (block << kBlockShift)));
-      };
-      jump = missesPending(blocks.masks + b * kMasksPerBlock, ox, oy, offset(last_x, bx),
-                           offset(last_y, by));
+      // Both cells lie in this block (the walk leaves it only with its leaving step).
+      jump = missesPending(blocks.masks + b * kMasksPerBlock, ox, oy, last_x & (kBlock - 1),
+                           last_y & (kBlock - 1));
     }
     if (jump) {
       // Every cell the walk would visit here is a no-op: cross the block, and every clean block

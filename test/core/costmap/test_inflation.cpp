@@ -57,6 +57,22 @@ CellBounds everything(const GridGeometry& g) {
   return b;
 }
 
+// Copies `truth` into `master` over the changed cells grown by the inflation radius (clamped to
+// the map), as a layer's update window does, and updates the inflation there.
+void applyChange(const Costmap& truth, const CellBounds& changed, Costmap* master,
+                 Inflator* inflator) {
+  CellBounds window = changed;
+  window.min_x -= inflator->radiusCells();
+  window.min_y -= inflator->radiusCells();
+  window.max_x += inflator->radiusCells();
+  window.max_y += inflator->radiusCells();
+  window = master->clamp(window);
+  for (int y = window.min_y; y <= window.max_y; ++y) {
+    for (int x = window.min_x; x <= window.max_x; ++x) master->setCost(x, y, truth.cost(x, y));
+  }
+  inflator->update(master, window);
+}
+
 }  // namespace
 
 TEST(InflationCost, LessonGoldenNumbers) {
@@ -273,16 +289,7 @@ TEST(Inflator, IncrementalUpdatesEqualFullRecomputation) {
           }
         }
       }
-      CellBounds window = changed;
-      window.min_x -= inflator.radiusCells();
-      window.min_y -= inflator.radiusCells();
-      window.max_x += inflator.radiusCells();
-      window.max_y += inflator.radiusCells();
-      window = master.clamp(window);
-      for (int y = window.min_y; y <= window.max_y; ++y) {
-        for (int x = window.min_x; x <= window.max_x; ++x) master.setCost(x, y, truth.cost(x, y));
-      }
-      inflator.update(&master, window);
+      applyChange(truth, changed, &master, &inflator);
     }
     Costmap fresh = truth;
     Inflator full(c, g.resolution());
@@ -630,16 +637,7 @@ TEST(InflatorMethods, IncrementalAndRollingUpdatesEqualFullRecomputationWithEith
             changed.expand(x, y);
           }
         }
-        CellBounds window = changed;
-        window.min_x -= inflator.radiusCells();
-        window.min_y -= inflator.radiusCells();
-        window.max_x += inflator.radiusCells();
-        window.max_y += inflator.radiusCells();
-        window = master.clamp(window);
-        for (int y = window.min_y; y <= window.max_y; ++y) {
-          for (int x = window.min_x; x <= window.max_x; ++x) master.setCost(x, y, truth.cost(x, y));
-        }
-        inflator.update(&master, window);
+        applyChange(truth, changed, &master, &inflator);
       }
       ASSERT_EQ(inflator.costs(), oracle(truth, c))
           << "radius " << radius << " method " << static_cast<int>(method);
