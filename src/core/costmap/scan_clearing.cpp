@@ -504,6 +504,19 @@ inline std::int32_t* blockPending(const ScanCells& sc, const Blocks& blocks, int
 
 __extension__ typedef __int128 Int128;  // GCC/Clang; __extension__: not ISO C++ (-Wpedantic)
 
+// The steps from the walk's cell (state err) to the first cell of the block it enters next, given
+// the steps along the crossing axis (*a for an x edge, *b for a y edge; the other is -1): fills in
+// the other axis's steps before that crossing (blockExit's order rule, in 128 bits).
+inline void enteringSteps(const RayWalk& walk, std::int64_t err, std::int64_t* a, std::int64_t* b) {
+  if (*a >= 0) {  // across an x edge: the y steps before the a-th x step
+    const Int128 num = static_cast<Int128>(err) + static_cast<Int128>(*a - 1) * walk.err_step_x;
+    *b = num <= 0 ? 0 : static_cast<std::int64_t>((num + walk.err_step_y - 1) / walk.err_step_y);
+  } else {  // across a y edge: the x steps before the b-th y step
+    const Int128 num = static_cast<Int128>(*b - 1) * walk.err_step_y - err;
+    *a = num < 0 ? 0 : static_cast<std::int64_t>(num / walk.err_step_x + 1);
+  }
+}
+
 // From the walk's state (x, y, err, left, p) in a block it leaves in one jump (nx, ny: its x and
 // y steps to the block's far edges), follows the blocks the walk enters next, without its cells:
 // the nx-th x crossing comes before the ny-th y crossing exactly when err + (nx - 1) esx -
@@ -541,17 +554,17 @@ inline bool crossCleanBlocks(const RayWalk& walk, const ScanCells& sc, const Blo
     }
     // Never past the end block (exact arithmetic never gets there; a guard, not a case).
     if ((bx - end_bx) * walk.sx > 0 || (by - end_by) * walk.sy > 0) return false;
+    const bool end_block = bx == end_bx && by == end_by;
+    // The end block entered at the end cell itself holds none of the walk's cells: not counted.
+    // This matters for a band's part of a ray (walkRaysInBands): its end cell is the first cell
+    // of its walk in the next band, whose blocks the other thread may be counting and clearing.
+    if (end_block) enteringSteps(walk, *err, &a, &b);
+    if (end_block && a + b >= *left) return false;
     if (*blockPending(sc, blocks, bx, by) == 0) {
-      if (bx == end_bx && by == end_by) return false;
+      if (end_block) return false;
       continue;
     }
-    if (a >= 0) {  // entered across an x edge: the y steps before the a-th x step
-      const Int128 num = static_cast<Int128>(*err) + static_cast<Int128>(a - 1) * esx;
-      b = num <= 0 ? 0 : static_cast<std::int64_t>((num + esy - 1) / esy);
-    } else {  // across a y edge: the x steps before the b-th y step
-      const Int128 num = static_cast<Int128>(b - 1) * esy - *err;
-      a = num < 0 ? 0 : static_cast<std::int64_t>(num / esx + 1);
-    }
+    if (!end_block) enteringSteps(walk, *err, &a, &b);
     *x += walk.sx * static_cast<int>(a);
     *y += walk.sy * static_cast<int>(b);
     *err = static_cast<std::int64_t>(static_cast<Int128>(*err) + static_cast<Int128>(a) * esx -

@@ -72,6 +72,25 @@ std::vector<BeamUpdate> randomScan(std::mt19937* rng, double sx, double sy, int 
   return beams;
 }
 
+// Each band of the two-thread walk touched only its own rows: the cells it updated (its flagged
+// list) and the blocks it counted. Bands run at the same time, so a band reaching into the next
+// one's blocks races with it (a ray's part ending at a band edge "ends" in the next band's first
+// row; counting that block there rewrote a count the other thread was decrementing).
+void expectBandsStayInTheirRows(const IntegrationScratch& s, int size_x) {
+  for (std::size_t b = 0; b < s.bands.size(); ++b) {
+    const int lo = s.bands[b].first_row;
+    const int hi = b + 1 < s.bands.size() ? s.bands[b + 1].first_row : 1 << 30;
+    for (const std::uint32_t i : s.bands[b].flagged) {
+      const int y = static_cast<int>(i / static_cast<std::uint32_t>(size_x));
+      ASSERT_TRUE(y >= lo && y < hi) << "band " << b << " updated row " << y;
+    }
+    for (const std::uint32_t k : s.bands[b].blocks_checked) {
+      const int y0 = static_cast<int>(k / static_cast<std::uint32_t>(s.blocks_x)) * 32;
+      ASSERT_TRUE(y0 + 31 >= lo && y0 < hi) << "band " << b << " counted the block at row " << y0;
+    }
+  }
+}
+
 void expectSameStats(const IntegrationStats& a, const IntegrationStats& b) {
   EXPECT_EQ(a.cells_cleared, b.cells_cleared);
   EXPECT_EQ(a.cells_marked, b.cells_marked);
@@ -309,6 +328,7 @@ TEST(ScanClearing, TwoThreadsSplitTheRaysAtABlockRow) {
     const IntegrationStats b =
         integrateBeams(two, scan, &two_scratch, ClearingWalk::kBlockSkip, 2, 0);
     expectSameStats(a, b);
+    expectBandsStayInTheirRows(two_scratch, g.sizeX());
     ASSERT_GE(two_scratch.bands.size(), 3u);
     std::size_t parts = 0;
     for (std::size_t b = 0; b < two_scratch.bands.size(); ++b) {
@@ -375,6 +395,8 @@ TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
         integrateBeams(threaded, scan, &threaded_scratch, ClearingWalk::kBlockSkip, 2, 0);
     expectSameStats(b, a);
     expectSameStats(c, a);
+    ASSERT_FALSE(threaded_scratch.bands.empty());
+    expectBandsStayInTheirRows(threaded_scratch, g.sizeX());
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
       ASSERT_EQ(threaded.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
