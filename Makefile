@@ -4,6 +4,7 @@
 #   make test   runs every test (gtest, rostest, pytest); exits non-zero if any fails
 # Hardening (docs/development.md, "Hardening and CI"):
 #   make test-sanitize   ASan+UBSan build (.ws-san) running the gtests and the pytests
+#   make test-tsan       TSan build (.ws-tsan) running the gtests of the two-thread code
 #   make fuzz            fixed-seed fuzz campaign (FUZZ_CASES=20000 by default, FUZZ_SEED=17)
 #   make fuzz-sanitize   the binding part of that campaign against the sanitized module
 #   make pip-check       pip install . in a fresh venv without ROS, then the pytests there
@@ -13,7 +14,7 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-.PHONY: help deps build install-check pip-check test test-sanitize fuzz fuzz-sanitize demo bench bench-open3d bench-tsdf-accuracy soak lint clean
+.PHONY: help deps build install-check pip-check test test-sanitize test-tsan fuzz fuzz-sanitize demo bench bench-open3d bench-tsdf-accuracy soak lint clean
 
 FUZZ_CASES ?= 20000
 FUZZ_SEED ?= 17
@@ -21,7 +22,7 @@ SOAK_MINUTES ?= 10
 SOAK_ONLY ?=
 
 help:
-	@echo "make demo | make test | make install-check | make pip-check | make test-sanitize | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make bench-tsdf-accuracy | make soak | make build | make deps | make lint | make clean"
+	@echo "make demo | make test | make install-check | make pip-check | make test-sanitize | make test-tsan | make fuzz | make fuzz-sanitize | make bench | make bench-open3d | make bench-tsdf-accuracy | make soak | make build | make deps | make lint | make clean"
 
 deps:
 	@tools/install_deps.sh
@@ -39,6 +40,10 @@ install-check: build
 
 test-sanitize: deps
 	@tools/test_sanitize.sh
+
+# ThreadSanitizer on the gtests of the code that shares work between threads (.ws-tsan).
+test-tsan: deps
+	@tools/test_tsan.sh
 
 # pyproject.toml: the ROS-free core as a Python package (docs/python.md, "Python without ROS").
 pip-check: deps
@@ -81,4 +86,4 @@ lint: deps
 	@tools/lint.sh
 
 clean:
-	rm -rf .ws .ws-san out
+	rm -rf .ws .ws-san .ws-tsan out

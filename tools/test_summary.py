@@ -14,9 +14,10 @@ import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-# The first line of every ASan / LSan / UBSan report.
+# The first line of every ASan / LSan / UBSan / TSan report.
 SANITIZER_REPORT = re.compile(
-    r"ERROR: (Address|Leak)Sanitizer|runtime error: |SUMMARY: UndefinedBehaviorSanitizer"
+    r"ERROR: (Address|Leak)Sanitizer|WARNING: ThreadSanitizer|runtime error: "
+    r"|SUMMARY: UndefinedBehaviorSanitizer"
 )
 
 
