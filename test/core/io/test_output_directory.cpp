@@ -72,8 +72,8 @@ TEST_F(OutputDirectoryTest, RefusesANulByteThatHidesAnotherExtension) {
 
 TEST_F(OutputDirectoryTest, RefusesAbsolutePathsAndEscapes) {
   const OutputDirectory out(dir_.string());
-  for (const std::string name : {victim_.string() + ".ply", std::string("../victim.ply"),
-                                 std::string("a/../../victim.ply"), std::string("a/../b.ply")}) {
+  for (const std::string& name : {victim_.string() + ".ply", std::string("../victim.ply"),
+                                  std::string("a/../../victim.ply"), std::string("a/../b.ply")}) {
     const OutputFileResult r = out.write(name, ".ply", "x", true);
     EXPECT_FALSE(r.ok()) << name;
   }

@@ -79,7 +79,7 @@ TEST(Tracker, OutOfRangeAndNegativeDetectionsAreCountedAndRefused) {
 TEST(TrackerConfig, RefusesNoiseAndAgesThatOverflowOrNeverEnd) {
   TrackerConfig c;
   EXPECT_EQ(c.validate(), "");
-  c.initial_velocity_std = 1.8e308;  // once a non-finite velocity covariance
+  c.initial_velocity_std = 1e200;  // finite, but its variance is not
   EXPECT_NE(c.validate(), "");
   c = TrackerConfig{};
   c.accel_psd = 1e7;

@@ -97,7 +97,8 @@ TEST(TsdfSlice, DistanceIsEuclideanToTheNearestOccupiedCell) {
   EXPECT_NEAR(distance[grid.index(12, 5)], 0.8, 1e-6);  // beside the unknown block
   EXPECT_THROW(sliceDistance(cells, grid, -0.1), std::invalid_argument);
   EXPECT_THROW(sliceDistance(cells, grid, std::nan("")), std::invalid_argument);
-  EXPECT_THROW(sliceDistance(cells, grid, 1.8e308), std::invalid_argument);  // +Inf as float
+  EXPECT_THROW(sliceDistance(cells, grid, std::numeric_limits<double>::infinity()),
+               std::invalid_argument);
   cells.pop_back();
   EXPECT_THROW(sliceDistance(cells, grid, cap), std::invalid_argument);
 }
