@@ -48,3 +48,28 @@ pybind11_cmake_args() {
     echo "-Dpybind11_DIR=$dir"
   fi
 }
+build_instrumented() {
+  # build_instrumented WS FLAGS LABEL [cmake args and targets...]: builds the given targets of the
+  # package with sanitizer FLAGS in a catkin workspace of its own (WS: .ws keeps its Release
+  # build), RelWithDebInfo at -O1 for readable reports, no LTO; log in WS/build.log. On failure
+  # prints the errors and "LABEL: 0 passed, 1 failed (build failed ...)" and returns 1.
+  local ws="$1" flags="$2" label="$3" start=$SECONDS
+  shift 3
+  mkdir -p "$ws/src" "$ROS_HOME"
+  link_package "$ws"
+  if [[ -f "$ws/build/CMakeCache.txt" ]] &&
+    ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" "$ws/build/CMakeCache.txt"; then
+    rm -rf "$ws/build" "$ws/devel" # a cache configured with another python (pitfall P14)
+  fi
+  if ! (cd "$ws" && catkin_make -j2 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=ON \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF \
+    "-DCMAKE_CXX_FLAGS=$flags" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
+    "-DCMAKE_EXE_LINKER_FLAGS=$flags" "-DCMAKE_SHARED_LINKER_FLAGS=$flags" \
+    "-DCMAKE_MODULE_LINKER_FLAGS=$flags" "$@" > "$ws/build.log" 2>&1); then
+    grep -E 'error|Error' "$ws/build.log" | head -40 || true
+    tail -40 "$ws/build.log"
+    echo "$label: 0 passed, 1 failed (build failed; log: $ws/build.log)"
+    return 1
+  fi
+  echo "$label: build ok in $((SECONDS - start)) s (log: $ws/build.log)"
+}

@@ -9,30 +9,13 @@ source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 SAN_WS="$REPO/.ws-san"
 SAN_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 RESULTS="$SAN_WS/results"
-mkdir -p "$SAN_WS/src" "$ROS_HOME"
-link_package "$SAN_WS"
-cd "$SAN_WS"
-if [[ -f build/CMakeCache.txt ]] && ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" build/CMakeCache.txt; then
-  rm -rf build devel # a cache configured with another python (pitfall P14)
-fi
-
 # Only the targets the tests need (the nodelets and rostests are not built: 2 cores in CI);
-# gencfg gives the pytests the dynamic_reconfigure Python modules.
-# RelWithDebInfo at -O1: readable reports, and pybind11 adds no LTO in that configuration.
-start=$SECONDS
+# gencfg gives the pytests the dynamic_reconfigure Python modules. pybind11 adds no LTO in the
+# RelWithDebInfo configuration.
 # shellcheck disable=SC2046 # pybind11_cmake_args: one argument or none
-if ! catkin_make -j2 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=ON \
-  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF $(pybind11_cmake_args) \
-  "-DCMAKE_CXX_FLAGS=$SAN_FLAGS" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
-  "-DCMAKE_EXE_LINKER_FLAGS=$SAN_FLAGS" "-DCMAKE_SHARED_LINKER_FLAGS=$SAN_FLAGS" \
-  "-DCMAKE_MODULE_LINKER_FLAGS=$SAN_FLAGS" \
-  downstream_perception_core test_core _core downstream_perception_gencfg > "$SAN_WS/build.log" 2>&1; then
-  grep -E 'error|Error' "$SAN_WS/build.log" | head -40 || true
-  tail -40 "$SAN_WS/build.log"
-  echo "sanitize: 0 passed, 1 failed (build failed; log: $SAN_WS/build.log)"
-  exit 1
-fi
-echo "sanitize: build ok in $((SECONDS - start)) s (log: $SAN_WS/build.log)"
+build_instrumented "$SAN_WS" "$SAN_FLAGS" sanitize $(pybind11_cmake_args) \
+  downstream_perception_core test_core _core downstream_perception_gencfg || exit 1
+cd "$SAN_WS"
 [[ "${1:-}" == "--build-only" ]] && exit 0 # tools/fuzz_sanitize.sh
 
 rm -rf "$RESULTS"

@@ -12,24 +12,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 TSAN_WS="$REPO/.ws-tsan"
 TSAN_FLAGS="-fsanitize=thread -fno-omit-frame-pointer"
 RESULTS="$TSAN_WS/results"
-mkdir -p "$TSAN_WS/src" "$ROS_HOME"
-link_package "$TSAN_WS"
+build_instrumented "$TSAN_WS" "$TSAN_FLAGS" tsan downstream_perception_core test_core || exit 1
 cd "$TSAN_WS"
-if [[ -f build/CMakeCache.txt ]] && ! grep -q "PYTHON_EXECUTABLE:FILEPATH=/usr/bin/python3" build/CMakeCache.txt; then
-  rm -rf build devel # a cache configured with another python (pitfall P14)
-fi
-start=$SECONDS
-if ! catkin_make -j2 -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCATKIN_ENABLE_TESTING=ON \
-  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF \
-  "-DCMAKE_CXX_FLAGS=$TSAN_FLAGS" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
-  "-DCMAKE_EXE_LINKER_FLAGS=$TSAN_FLAGS" "-DCMAKE_SHARED_LINKER_FLAGS=$TSAN_FLAGS" \
-  downstream_perception_core test_core > "$TSAN_WS/build.log" 2>&1; then
-  grep -E 'error|Error' "$TSAN_WS/build.log" | head -40 || true
-  tail -40 "$TSAN_WS/build.log"
-  echo "tsan: 0 passed, 1 failed (build failed; log: $TSAN_WS/build.log)"
-  exit 1
-fi
-echo "tsan: build ok in $((SECONDS - start)) s (log: $TSAN_WS/build.log)"
 rm -rf "$RESULTS"
 mkdir -p "$RESULTS"
 # halt_on_error: a report fails the run even where the test's own comparisons happen to pass.
