@@ -129,10 +129,10 @@ struct IntegrationScratch {
   std::vector<std::uint8_t> row_changed;  ///< mark-sweep: per cell of a row, state class changed
   int blocks_x = 0;                       ///< block_pending's layout (blocks per row)
   int blocks_y = 0;
-  /// The banded walk (see integrateBeams): each band's ray parts, flags, blocks and results.
+  /// The banded walk (see integrateBeams): each band's flags, blocks and results.
   struct Band {
-    int first_row = 0;  ///< rows [first_row, next band's first_row)
-    std::vector<ClearingRay> rays;
+    int first_row = 0;      ///< rows [first_row, next band's first_row)
+    std::size_t parts = 0;  ///< ray parts walked in the band (a ray crossing k edges has k + 1)
     std::vector<std::uint32_t> flagged;
     std::vector<std::uint32_t> blocks_checked;
     IntegrationStats stats;
@@ -153,10 +153,11 @@ constexpr std::size_t kScanThreadMinCells = 200000;
 /// `thread_min_cells` ray cells, pass 2 is shared with a helper thread (runShared): the grid is
 /// cut into bands of rows (at block boundaries) holding about equal shares of the rays' cells,
 /// each band's cells are walked by whichever thread claims the band (a ray crossing a band edge is
-/// split exactly where its own walk crosses it), and rays through lattice corners that cross an
-/// edge are walked after all bands. Each cell still gets at most one update per scan and the
-/// result does not depend on the order of the updates, so the grid and the statistics are the
-/// same as one thread's bit for bit (only the internal order of the flag list differs).
+/// split exactly where its own walk crosses it, by the band's own task), and rays through lattice
+/// corners that cross an edge are walked before the bands, on the calling thread. Each cell still
+/// gets at most one update per scan and the result does not depend on the order of the updates, so
+/// the grid and the statistics are the same as one thread's bit for bit (only the internal order of
+/// the flag list differs).
 IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
                                 IntegrationScratch* scratch = nullptr,
                                 ClearingWalk walk = ClearingWalk::kAuto, int threads = 1,
