@@ -666,7 +666,6 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlongBlocks(const RayW
 // The walk a scan's rays take in pass 2 (chosen in integrateBeams).
 enum class RayWalkKind { kPerRay, kBlocks, kFirstVisits };
 
-// Walks the clearing rays (pass 2) with the chosen walk; returns the cells walked.
 // Walks one clearing ray (pass 2) with the chosen walk; adds the cells walked to *walked.
 inline void walkRay(const RayWalk& walk, bool clear_end_cell, const ScanCells& sc,
                     const Blocks& blocks, RayWalkKind kind, std::size_t* walked) {
