@@ -56,13 +56,37 @@ PAIRS = {
         "",
         "move_base_launch_params.yaml",
     ),
+    "ridgeback": (
+        "costmap_common_params.yaml",
+        "global_costmap_params.yaml",
+        "local_costmap_params.yaml",
+        "",
+        "",
+        "",
+    ),
+    "freight": (
+        "costmap_common.yaml",
+        "costmap_global.yaml",
+        "costmap_local.yaml",
+        "global_costmap",
+        "local_costmap",
+        "",
+    ),
 }
-# root, global_more, local_more: files loaded besides the pair (real_configs.launch's args).
+# root, global_more, local_more, common_more: files loaded besides the pair (real_configs.launch's
+# args).
 MORE = {
     "mir": (
         "move_base_common_params.yaml",
         "costmap_global_params_plugins_no_virtual_walls.yaml",
         "costmap_local_params_plugins_no_virtual_walls.yaml",
+        "",
+    ),
+    "freight": (
+        "",
+        "freight_costmap_global.yaml",
+        "freight_costmap_local.yaml",
+        "freight_costmap_common.yaml",
     ),
 }
 
@@ -70,7 +94,7 @@ MORE = {
 def tree_of(robot: str) -> mbc.Params:
     common, glob, local, gns, lns, extra = PAIRS[robot]
     d = CONFIGS / robot
-    root, gmore, lmore = (str(d / f) if f else "" for f in MORE.get(robot, ("", "", "")))
+    root, gmore, lmore, cmore = (str(d / f) if f else "" for f in MORE.get(robot, ("", "", "", "")))
     return mbc.load_pair(
         str(d / common),
         str(d / glob),
@@ -81,6 +105,7 @@ def tree_of(robot: str) -> mbc.Params:
         root,
         gmore,
         lmore,
+        cmore,
     )
 
 
@@ -97,6 +122,33 @@ def test_root_and_more_files_like_mir_launch() -> None:
     assert {s.raytrace_range for s in local.sources()} == {6.0}
     assert {s.obstacle_range for s in local.sources()} == {3.0}
     assert [s.marking for s in local.sources()] == [True, False, True, False]
+
+
+def test_common_plugins_replaced_by_the_global_list_like_ridgeback() -> None:
+    """Ridgeback: the common file's plugins list reaches both costmaps; the global file's list
+    replaces it there (rosparam load replaces a list), the local costmap keeps it."""
+    glob, local = mbc.costmaps_of(tree_of("ridgeback"))
+    assert [layer.name for layer in glob.layers] == [
+        "static_layer",
+        "obstacles_layer",
+        "inflater_layer",
+    ]
+    assert [layer.name for layer in local.layers] == ["obstacles_layer", "inflater_layer"]
+    (src,) = local.sources()
+    assert (src.topic, src.sensor_frame, src.obstacle_range) == ("/front/scan", "front_laser", 2.5)
+    assert local.rolling and local.global_frame == "map"
+
+
+def test_common_more_file_like_fetch_launch() -> None:
+    """Freight: the per-robot common file (common_more) adds the source to both costmaps, the
+    per-robot costmap files the plugins lists; the VoxelLayer without voxel keys takes
+    costmap_2d's defaults (10 voxels of 0.2 m from 0)."""
+    glob, local = mbc.costmaps_of(tree_of("freight"))
+    assert [layer.name for layer in glob.layers] == ["static_map", "obstacles", "inflater"]
+    assert [layer.name for layer in local.layers] == ["obstacles", "inflater"]
+    assert glob.layers[1].z_band() == (0.0, 0.2 * 10)
+    assert {(s.obstacle_range, s.raytrace_range) for s in local.sources()} == {(6.0, 10.0)}
+    assert local.rolling and local.size_cells() == (160, 160)
 
 
 def test_merge_unrolls_dictionaries_like_roslaunch() -> None:
@@ -215,6 +267,21 @@ def test_inflation_formula_and_translation() -> None:
         100,
         -1,
     ]
+
+
+def test_inflation_radius_rule_of_each_host() -> None:
+    """Ridgeback's 0.25 m at 0.1 m: costmap_2d inflates to ceil = 3 cells, our host to 2.5 cells
+    (docs/migrating.md); a whole number of cells is the same for both."""
+    theirs = mbc.Inflation(0.25, 10.0, 0.5, 0.1)
+    ours = mbc.Inflation(0.25, 10.0, 0.5, 0.1, ceil_cells=False)
+    assert (theirs.cost(3), ours.cost(3), ours.cost(2.5), ours.cost(math.sqrt(5))) == (
+        253,
+        0,
+        253,
+        253,
+    )
+    whole = [mbc.Inflation(0.3, 10.0, 0.1, 0.1, ceil_cells=c) for c in (True, False)]
+    assert [w.cost(3) for w in whole] == [whole[0].cost(3)] * 2 and whole[0].cost(3) > 0
 
 
 def test_ros_int_rounds_like_roscpp() -> None:

@@ -103,6 +103,7 @@ def load_pair_from(get: Any, ns: str = "/real_config") -> Params:
         get(f"{ns}/root", ""),
         get(f"{ns}/global_more", ""),
         get(f"{ns}/local_more", ""),
+        get(f"{ns}/common_more", ""),
     )
 
 
@@ -116,10 +117,12 @@ def load_pair(
     root: str = "",
     global_more: str = "",
     local_more: str = "",
+    common_more: str = "",
 ) -> Params:
     """The parameter tree move_base's launch files build: `root` (move_base's own file, e.g. the
     footprint) at the root, the common file into global_costmap and local_costmap, then the global
-    and local files (each followed by its optional `*_more` file, e.g. a plugins list) into
+    and local files (each followed by its optional `*_more` file, e.g. a plugins list; the
+    common file by `common_more`, e.g. Fetch's per-robot common file) into
     global_ns / local_ns ("" when the file starts with its own `global_costmap:` /
     `local_costmap:` key), then `extra` at the root."""
     tree: Params = {}
@@ -132,6 +135,9 @@ def load_pair(
         merge(tree, "", read(root))
     merge(tree, "global_costmap", read(common))
     merge(tree, "local_costmap", read(common))
+    if common_more:
+        merge(tree, "global_costmap", read(common_more))
+        merge(tree, "local_costmap", read(common_more))
     merge(tree, global_ns, read(global_file))
     if global_more:
         merge(tree, global_ns, read(global_more))
@@ -174,7 +180,11 @@ def plugin_list(costmap: Params) -> list[dict[str, str]]:
     if "plugins" in costmap:
         plugins = [{"name": str(p["name"]), "type": str(p["type"])} for p in costmap["plugins"]]
         for p in plugins:
-            layer = costmap.setdefault(p["name"], {})
+            if not isinstance(costmap.get(p["name"]), dict):
+                # A layer named like a scalar key (Freight's `static_map` layer beside
+                # `static_map: true`) reads none of it: its own keys are all defaults.
+                costmap[p["name"]] = {}
+            layer = costmap[p["name"]]
             kind = OUR_TYPES.get(p["type"], p["type"])
             keys = COPIED_KEYS.get(kind, ())
             for key in keys:
@@ -391,6 +401,10 @@ class Inflation:
     cost_scaling_factor: float
     inscribed_radius: float
     resolution: float
+    # costmap_2d inflates to ceil(radius / resolution) cells; our InflationLayer to the radius
+    # itself (docs/migrating.md, `inflation_radius`): they differ when the radius is not a whole
+    # number of cells (Ridgeback: 0.25 m at 0.1 m).
+    ceil_cells: bool = True
 
     @property
     def cell_radius(self) -> int:
@@ -398,8 +412,13 @@ class Inflation:
         return int(max(0.0, math.ceil(self.inflation_radius / self.resolution)))
 
     def cost(self, distance_cells: float) -> int:
-        """computeCost(distance in cells), 0 beyond cell_radius."""
+        """computeCost(distance in cells), 0 beyond cell_radius (ceil_cells) or beyond the
+        radius itself (our host, to within its 1e-6 relative tolerance)."""
         if distance_cells > self.cell_radius:
+            return FREE
+        if not self.ceil_cells and distance_cells * self.resolution > self.inflation_radius * (
+            1.0 + 1e-6
+        ):
             return FREE
         if distance_cells == 0:
             return LETHAL
@@ -413,7 +432,8 @@ class Inflation:
         return int((INSCRIBED - 1) * factor)
 
 
-def inflation_of(costmap: Costmap, resolution: float) -> Inflation | None:
+def inflation_of(costmap: Costmap, resolution: float, ceil_cells: bool = True) -> Inflation | None:
+    """The costs of the costmap's first inflation layer (ceil_cells=False: our host's rule)."""
     layers = costmap.layers_of("inflation")
     if not layers:
         return None
@@ -423,6 +443,7 @@ def inflation_of(costmap: Costmap, resolution: float) -> Inflation | None:
         cost_scaling_factor=float(layer.get("cost_scaling_factor", 10.0)),
         inscribed_radius=costmap.inscribed_radius(),
         resolution=resolution,
+        ceil_cells=ceil_cells,
     )
 
 
