@@ -10,9 +10,25 @@ CostmapPublisher::CostmapPublisher(ros::NodeHandle& nh, const std::string& topic
   // Latched, and a new subscriber makes the next message a full grid: late subscribers get a map
   // at once, then one that matches the updates that follow (costmap_2d does the same).
   full_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>(
-      topic, 1, [this](const ros::SingleSubscriberPublisher&) { need_full_ = true; },
+      topic, 1,
+      [this](const ros::SingleSubscriberPublisher& subscriber) {
+        need_full_ = true;
+        sendCurrent(subscriber);
+      },
       ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
   update_publisher_ = nh.advertise<map_msgs::OccupancyGridUpdate>(topic + "_updates", 10);
+}
+
+void CostmapPublisher::setNewSubscriberSource(GridSource source) {
+  std::lock_guard<std::mutex> lock(source_mutex_);
+  new_subscriber_source_ = std::move(source);
+}
+
+void CostmapPublisher::sendCurrent(const ros::SingleSubscriberPublisher& subscriber) {
+  std::lock_guard<std::mutex> lock(source_mutex_);
+  if (!new_subscriber_source_) return;
+  nav_msgs::OccupancyGrid msg;
+  if (new_subscriber_source_(&msg)) subscriber.publish(msg);
 }
 
 void CostmapPublisher::toMessage(const Costmap& costmap, const std::string& frame_id,

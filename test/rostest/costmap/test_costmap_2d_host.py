@@ -3,9 +3,10 @@
 
 prehydro: no ~plugins, so the list costmap_2d generates (obstacle_layer, inflation_layer) with the
 pre-Hydro keys moved into it; a misspelt and a wrongly typed key are named. empty: no layers is an
-ERROR, and publish_frequency's default 0 publishes nothing. /robot/aliases: costmap_2d's type name
-and the move_base spelling load our layers, the footprint is found one namespace up, a host-level
-key costmap_2d would not copy is named, and a rejected reconfigure value is reverted."""
+ERROR, and publish_frequency's default 0 publishes nothing but a new subscriber's grid.
+/robot/aliases: costmap_2d's type name and the move_base spelling load our layers, the footprint
+is found one namespace up, a host-level key costmap_2d would not copy is named, and a rejected
+reconfigure value is reverted."""
 
 from __future__ import annotations
 
@@ -120,7 +121,11 @@ class Costmap2dHostTest(unittest.TestCase):
         values = {kv.key: kv.value for kv in status.values}
         self.assertEqual(float(values["update rate requested (Hz)"]), 5.0)
 
-    def test_no_layers_is_an_error_and_publish_frequency_zero_publishes_nothing(self) -> None:
+    def test_no_layers_is_an_error_and_publish_frequency_zero_answers_new_subscribers_only(
+        self,
+    ) -> None:
+        """publish_frequency's default 0: no periodic grid, but the new subscriber gets the
+        current grid once (costmap_2d's Costmap2DPublisher::onNewSubscription)."""
         received: list[OccupancyGrid] = []
         sub = rospy.Subscriber("/empty/costmap", OccupancyGrid, received.append)
         status = self.diag("/empty")
@@ -128,7 +133,9 @@ class Costmap2dHostTest(unittest.TestCase):
         self.assertIn("no layers", status.message)
         time.sleep(2.0)
         sub.unregister()
-        self.assertEqual(received, [], "published although publish_frequency defaults to 0")
+        self.assertEqual(
+            len(received), 1, "publish_frequency 0: expected one grid for the new subscriber"
+        )
 
     def test_costmap_2d_type_names_load_our_layers(self) -> None:
         self.diag("/robot/aliases", "layer obstacles")

@@ -39,6 +39,7 @@ from move_base_config import (
     load_pair_from,
     translate,
 )
+from nav_msgs.msg import OccupancyGrid
 
 from downstream_perception.ros.costmap_client import CostmapClient
 from downstream_perception.ros.util import wait_until
@@ -82,14 +83,23 @@ class RealConfigTest(unittest.TestCase):
         tree = load_pair_from(rospy.get_param)
         cls.scene = build_scene(tree)
         cls.costmaps = list(costmaps_of(tree))
-        cls.clients = {cm.ns: CostmapClient(f"{prefix}/{cm.ns}/costmap") for cm in cls.costmaps}
+        cls.topics = {cm.ns: f"{prefix}/{cm.ns}/costmap" for cm in cls.costmaps}
+        # No standing subscription to a costmap with publish_frequency 0 (Freight's global one):
+        # nothing is published there, but costmap_2d sends the current grid to each new
+        # subscriber (onNewSubscription), so snapshot() subscribes anew (rospy would hand a second
+        # subscriber of the same topic the first connection's latched message instead).
+        cls.clients = {
+            cm.ns: CostmapClient(cls.topics[cm.ns])
+            for cm in cls.costmaps
+            if float(cm.get("publish_frequency", 0.0)) > 0.0
+        }
         cls.diagnostics: dict[str, DiagnosticStatus] = {}
         rospy.Subscriber("/diagnostics", DiagnosticArray, cls._on_diagnostics, queue_size=20)
         cls.pose_pub = rospy.Publisher(
             "/real_config_sim/robot_pose", Pose2D, queue_size=1, latch=True
         )
         cls.robot_xy = cls.scene.start
-        wait_until(lambda: all(c.received for c in cls.clients.values()), 90.0)
+        wait_until(lambda: all(cls.snapshot(cm) is not None for cm in cls.costmaps), 90.0)
         # Let the slowest costmap integrate a few scans and publish them: the near box lethal in
         # every costmap with an obstacle layer (or 60 s), then two more publish cycles.
         wait_until(lambda: all(cls._near_seen(cm) for cm in cls.costmaps), 60.0)
@@ -129,10 +139,16 @@ class RealConfigTest(unittest.TestCase):
 
     @classmethod
     def snapshot(cls, cm: Costmap) -> Snapshot | None:
-        client = cls.clients[cm.ns]
-        if not client.received:
+        client = cls.clients.get(cm.ns)
+        if client is None:  # publish_frequency 0: a new subscriber's grid
+            try:
+                msg = rospy.wait_for_message(cls.topics[cm.ns], OccupancyGrid, timeout=5.0)
+            except rospy.ROSException:
+                return None
+        elif not client.received:
             return None
-        msg = client.message()
+        else:
+            msg = client.message()
         grid = np.asarray(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
         o = msg.info.origin.position
         return Snapshot(grid, float(msg.info.resolution), (float(o.x), float(o.y)))

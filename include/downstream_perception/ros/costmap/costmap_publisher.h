@@ -9,6 +9,8 @@
 #include <ros/ros.h>
 
 #include <atomic>
+#include <functional>
+#include <mutex>
 #include <string>
 
 #include "downstream_perception/core/grid/costmap.h"
@@ -25,6 +27,12 @@ class CostmapPublisher {
   /// update, or nothing if it is empty.
   void publish(const Costmap& costmap, const ros::Time& stamp, const CellBounds& changed);
   void setAlwaysSendFull(bool always) { always_send_full_ = always; }
+  /// Fills the current grid for a new subscriber of <topic>, or returns false (nothing to send).
+  using GridSource = std::function<bool(nav_msgs::OccupancyGrid*)>;
+  /// When set, each new subscriber of <topic> gets the grid `source` fills at once, sent to it
+  /// alone: costmap_2d's Costmap2DPublisher::onNewSubscription, which is how a costmap with
+  /// publish_frequency 0 (Fetch's global costmap) still reaches rviz or a planner.
+  void setNewSubscriberSource(GridSource source);
   /// The next publish() sends the whole grid.
   void requestFull() { need_full_ = true; }
 
@@ -38,6 +46,8 @@ class CostmapPublisher {
                               map_msgs::OccupancyGridUpdate* msg);
 
  private:
+  void sendCurrent(const ros::SingleSubscriberPublisher& subscriber);
+
   ros::Publisher full_publisher_;
   ros::Publisher update_publisher_;
   std::string frame_id_;
@@ -46,6 +56,8 @@ class CostmapPublisher {
   GridGeometry last_geometry_;
   std::size_t full_published_ = 0;
   std::size_t updates_published_ = 0;
+  std::mutex source_mutex_;
+  GridSource new_subscriber_source_;
 };
 
 }  // namespace downstream_perception
