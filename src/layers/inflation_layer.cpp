@@ -75,13 +75,18 @@ bool InflationLayer::applyConfig(InflationConfig candidate, const std::string& e
     }
     config_errors_.set(error_key, msg);
   }
+  // Allowed (costmap_2d accepts it) but the robot would touch walls the planner thinks clear.
+  // Once per pair of radii: the config is applied again on every resize and footprint update.
+  std::string small_radius;
   if (candidate.inflation_radius < candidate.inscribed_radius) {
-    // Allowed (costmap_2d accepts it) but the robot would touch walls the planner thinks clear.
-    ROS_WARN(
-        "layer '%s': inflation_radius %.3f m is smaller than the footprint's inscribed "
-        "radius %.3f m",
-        name_.c_str(), candidate.inflation_radius, candidate.inscribed_radius);
+    small_radius = "inflation_radius " + toText(candidate.inflation_radius) +
+                   " m is smaller than the footprint's inscribed radius " +
+                   toText(candidate.inscribed_radius) + " m";
   }
+  if (!small_radius.empty() && small_radius != small_radius_note_) {
+    ROS_WARN("layer '%s': %s", name_.c_str(), small_radius.c_str());
+  }
+  small_radius_note_ = small_radius;
   config_ = candidate;
   inflator_ = std::make_unique<Inflator>(config_, resolution);
   need_full_window_ = true;

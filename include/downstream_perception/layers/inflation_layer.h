@@ -43,10 +43,10 @@ class InflationLayer : public Layer {
   InflationConfig config_;  ///< inscribed_radius comes from the footprint
   std::unique_ptr<Inflator> inflator_;
   ConfigErrorLog config_errors_;
-  bool need_full_window_ = true;
-  std::string radius_note_;                  ///< how this radius differs from costmap_2d's, or ""
-  std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)  ///< after
-                                             ///< (re)configuration: update the whole map once
+  bool need_full_window_ = true;   ///< after (re)configuration: update the whole map once
+  std::string radius_note_;        ///< how this radius differs from costmap_2d's, or ""
+  std::string small_radius_note_;  ///< the radius is below the inscribed one (warned once), or ""
+  std::vector<std::string> param_warnings_;  ///< wrong types, unknown keys (start-up)
   InflationStats last_;
   std::size_t updates_ = 0;
   RunningStats update_ms_;
