@@ -4,22 +4,25 @@ whose tracked-obstacle cells show it, with the real tracker and costmap nodelets
 (bench/bench_latency.launch, bench/bench_latency.yaml: update and publish at 10 Hz).
 
 One process plays the sensors on its own ROS master: scans at 10 Hz, each with a small blip at
-one of 8 places (one return marks a cell, the next scan's pass-through clears it), and
+one of 8 places (one return marks a cell LETHAL, the next two scans' pass-throughs clear it), and
 detections at 15 Hz of short-lived objects (a new one every 0.5 s, seen for 0.4 s, each at its
 own place; the obstacle layer marks on one return from a floor of -0.5, as costmap_2d
 marks). Latency = the receive time of the first costmap message (full grid or update) in
-which the blip's or object's cell is LETHAL, minus the message's stamp; for objects both from the
-first detection (what a planner experiences, including the tracker's min_hits confirmation)
-and from the confirming detection. The receive times are taken by a probe in a process of its
-own (this file run with --probe), which learns what to watch from the scans and detections it
-receives: in the sensors' process the probe's callbacks waited for the interpreter lock while the
-sensor loops ran, which added up to tens of milliseconds to some latencies.
+which the blip's or object's cell is LETHAL, minus the message's stamp (a message received
+before the probe handled the scan itself counts too: each subscription has its own thread);
+for objects both from the first detection (what a planner experiences, including the
+tracker's min_hits confirmation) and from the confirming detection. The receive times are
+taken by a probe in a process of its own (this file run with --probe), which learns what to
+watch from the scans and detections it receives: in the sensors' process the probe's callbacks
+waited for the interpreter lock while the sensor loops ran, which added up to tens of
+milliseconds to some latencies.
 
 Used by bench.py; runnable alone in a sourced workspace: python3 bench/bench_latency.py
 """
 
 from __future__ import annotations
 
+import collections
 import json
 import multiprocessing
 import os
@@ -58,6 +61,12 @@ class Probe:
         # key -> (stamps to measure from, window rows/cols); measured keys move to results.
         self.pending: dict[Any, tuple[list[Any], tuple[slice, slice]]] = {}
         self.results: dict[str, list[list[float]]] = {"scan": [], "object": []}
+        # The costmap messages of the last few seconds (receive time, row, column, cells): the
+        # costmap can answer a scan before this process has handled that scan itself (each
+        # subscription has its own thread), so a new watch first looks back through them.
+        self.recent: collections.deque[tuple[Any, int, int, np.ndarray]] = collections.deque(
+            maxlen=100
+        )
         self.missed = {"scan": 0, "object": 0}
         rospy.Subscriber(
             "/costmap/costmap", OccupancyGrid, self.on_full, queue_size=5, tcp_nodelay=True
@@ -107,6 +116,7 @@ class Probe:
                 with self.lock:
                     if ("object", j) in self.pending:
                         self.pending[("object", j)][0][:] = [stamps[0], stamps[2]]
+                        self.look_back(("object", j))
 
     def on_diagnostics(self, msg: Any) -> None:
         for status in msg.status:
@@ -123,12 +133,27 @@ class Probe:
             if key in self.pending:
                 self.missed[key[0]] += 1
             self.pending[key] = (stamps, (slice(r - half, r + half + 1), slice(c - 2, c + 3)))
+            self.look_back(key)
+
+    def look_back(self, key: Any) -> None:
+        """Measures `key` at the first message already received after its latest stamp whose
+        cells show it LETHAL (the lock is held)."""
+        stamps, (rows, cols) = self.pending[key]
+        if not stamps:
+            return
+        since = max(stamps)
+        for now, y, x, cells in self.recent:
+            if now >= since and shows_lethal((rows, cols), y, x, cells):
+                self.results[key[0]].append([(now - s).to_sec() for s in stamps])
+                del self.pending[key]
+                return
 
     def on_full(self, msg: Any) -> None:
         now = self.rospy.Time.now()
         with self.lock:
             self.grid = np.asarray(msg.data, dtype=np.int8).reshape(msg.info.height, -1).copy()
-            self.check(now)
+            self.recent.append((now, 0, 0, self.grid.copy()))
+            self.check(now, 0, 0, self.grid)
 
     def on_update(self, msg: Any) -> None:
         now = self.rospy.Time.now()
@@ -137,15 +162,24 @@ class Probe:
                 return
             patch = np.asarray(msg.data, dtype=np.int8).reshape(msg.height, msg.width)
             self.grid[msg.y : msg.y + msg.height, msg.x : msg.x + msg.width] = patch
-            self.check(now)
+            self.recent.append((now, msg.y, msg.x, patch))
+            self.check(now, msg.y, msg.x, patch)
 
-    def check(self, now: Any) -> None:
-        assert self.grid is not None
+    def check(self, now: Any, y: int, x: int, cells: np.ndarray) -> None:
+        """Measures each watched key this message (cells at row y, column x) shows LETHAL."""
         for key in list(self.pending):
             stamps, window = self.pending[key]
-            if stamps and (self.grid[window] == 100).any():
+            if stamps and shows_lethal(window, y, x, cells):
                 self.results[key[0]].append([(now - s).to_sec() for s in stamps])
                 del self.pending[key]
+
+
+def shows_lethal(window: tuple[slice, slice], y: int, x: int, cells: np.ndarray) -> bool:
+    """Whether the cells (a costmap message's, at row y, column x) hold LETHAL in the window."""
+    rows, cols = window
+    r0, r1 = max(rows.start, y), min(rows.stop, y + cells.shape[0])
+    c0, c1 = max(cols.start, x), min(cols.stop, x + cells.shape[1])
+    return r0 < r1 and c0 < c1 and bool((cells[r0 - y : r1 - y, c0 - x : c1 - x] == 100).any())
 
 
 def run(duration_s: float = 30.0, update_on_data: bool = False) -> dict[str, Any]:

@@ -7,15 +7,15 @@ namespace downstream_perception {
 CostmapPublisher::CostmapPublisher(ros::NodeHandle& nh, const std::string& topic,
                                    std::string frame_id, bool always_send_full)
     : frame_id_(std::move(frame_id)), always_send_full_(always_send_full) {
-  // Latched, and a new subscriber makes the next message a full grid: late subscribers get a map
-  // at once, then one that matches the updates that follow (costmap_2d does the same).
+  // Not latched: a latched topic would hand a late subscriber the last full grid published,
+  // however old. Each new subscriber gets the current grid at once instead (costmap_2d's
+  // onNewSubscription), and the next message is a full grid, so that it also matches the updates
+  // that follow whatever order the two topics arrive in.
   full_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>(
-      topic, 1,
-      [this](const ros::SingleSubscriberPublisher& subscriber) {
+      topic, 1, [this](const ros::SingleSubscriberPublisher& subscriber) {
         need_full_ = true;
         sendCurrent(subscriber);
-      },
-      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
+      });
   update_publisher_ = nh.advertise<map_msgs::OccupancyGridUpdate>(topic + "_updates", 10);
 }
 

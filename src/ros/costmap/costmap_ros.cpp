@@ -40,9 +40,7 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   publisher_ = std::make_unique<CostmapPublisher>(pnh_, "costmap", config_.global_frame,
                                                   config_.always_send_full_costmap);
   publisher_->setNewSubscriberSource([this](nav_msgs::OccupancyGrid* msg) {
-    // Only where nothing else publishes: publish_frequency 0 (costmap_2d answers every new
-    // subscriber this way; at > 0 our latched grid and the next full message serve them).
-    if (config_.publish_frequency > 0.0) return false;
+    // Every new subscriber, whatever publish_frequency (costmap_2d answers each one this way).
     std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
     CostmapPublisher::toMessage(layered_costmap_->costmap(), config_.global_frame, ros::Time::now(),
                                 msg);

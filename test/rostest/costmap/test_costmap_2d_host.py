@@ -11,6 +11,8 @@ reconfigure value is reverted."""
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 import time
 import unittest
 
@@ -110,6 +112,25 @@ class Costmap2dHostTest(unittest.TestCase):
         # inflation_radius 0.4 m (moved from the host): a cost 0.3 m beside the hit, none at 0.5 m.
         self.assertGreater(cell(0.325, 0.825), 0, "no inflation 0.3 m from the obstacle")
         self.assertEqual(cell(0.525, 0.825), 0, "inflated beyond inflation_radius 0.4 m")
+
+    def test_prehydro_a_late_subscriber_first_gets_the_current_grid(self) -> None:
+        """costmap_2d sends each new subscriber the current grid, whatever publish_frequency
+        (5 Hz here). A latched ~costmap handed it the last full grid published instead, drawn
+        before the obstacle. A process of its own: rospy shares one connection per topic."""
+        self.test_prehydro_marks_within_obstacle_range_and_inflates_by_the_moved_radius()
+        code = (
+            "import rospy; from nav_msgs.msg import OccupancyGrid;"
+            "rospy.init_node('late_subscriber', anonymous=True);"
+            "m = rospy.wait_for_message('/prehydro/costmap', OccupancyGrid, timeout=20.0);"
+            "i = int((0.825 - m.info.origin.position.y) / m.info.resolution);"
+            "j = int((0.025 - m.info.origin.position.x) / m.info.resolution);"
+            "print(m.data[i * m.info.width + j])"
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, timeout=60.0
+        )
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertEqual(int(out.stdout.strip()), LETHAL, "the first grid was not the current one")
 
     def test_prehydro_names_the_misspelt_and_the_string_key(self) -> None:
         self.assertTrue(wait_until(lambda: len(self.warnings("/prehydro")) >= 2, 20.0))
