@@ -81,7 +81,9 @@ Mesh = tuple[np.ndarray, np.ndarray]  # vertices (V, 3), triangles (T, 3)
 Integrator = Callable[[Sequence[np.ndarray], Sequence[np.ndarray], Any, float], Mesh]
 
 
-def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD) -> Integrator:
+def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD, dropoff: bool | None = None) -> Integrator:
+    """Ours at this edge guard; dropoff: behind_surface_dropoff (None: the default)."""
+
     def integrate(
         depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any, voxel_m: float
     ) -> Mesh:
@@ -91,6 +93,8 @@ def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD) -> Integrator:
         config.voxel_size_m = voxel_m
         config.truncation_voxels = TRUNCATION_VOXELS
         config.edge_guard_rad = edge_guard_rad
+        if dropoff is not None:
+            config.behind_surface_dropoff = dropoff
         tsdf = dp.Tsdf(config)
         pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
         for depth, pose in zip(depths, poses, strict=True):
@@ -164,12 +168,20 @@ def open3d_tensor(
     return mesh.vertex.positions.numpy(), mesh.triangle.indices.numpy()
 
 
-def integrators(edge_guards: Sequence[float]) -> dict[str, Integrator]:
-    """Ours at each edge guard (the default one named plainly), then Open3D's when it imports."""
+def integrators(
+    edge_guards: Sequence[float], dropoffs: Sequence[bool | None] = (None,), open3d: bool = True
+) -> dict[str, Integrator]:
+    """Ours at each edge guard and behind_surface_dropoff setting (None: the default; the
+    defaults' one named plainly), then Open3D's when it imports (and `open3d`)."""
     found: dict[str, Integrator] = {}
     for rad in edge_guards:
-        name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
-        found[name] = ours(rad)
+        for dropoff in dropoffs:
+            name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
+            if dropoff is not None:
+                name += f", behind_surface_dropoff {'on' if dropoff else 'off'}"
+            found[name] = ours(rad, dropoff)
+    if not open3d:
+        return found
     try:
         import open3d  # noqa: F401
     except ImportError:
@@ -232,12 +244,14 @@ def run(
     frames: int,
     camera_scale: float = 1.0,
     log: Callable[[str], None] = print,
+    dropoffs: Sequence[bool | None] = (None,),
+    open3d: bool = True,
 ) -> list[Score]:
     from downstream_perception.sim.depth_camera import DepthCamera
     from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
     from downstream_perception.tsdf_eval import observed_samples
 
-    chosen = integrators(edge_guards)
+    chosen = integrators(edge_guards, dropoffs, open3d)
     cameras = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
@@ -370,6 +384,12 @@ def main() -> None:
         default=",".join(f"{f:g}" for f in OFFSET_FRACTIONS),
         help="comma-separated lattice offsets, fractions of a voxel (for a quicker subset)",
     )
+    parser.add_argument(
+        "--dropoff",
+        default="default",
+        help="comma-separated behind_surface_dropoff settings for ours: default, on, off",
+    )
+    parser.add_argument("--no-open3d", action="store_true", help="ours only")
     parser.add_argument("--json", type=Path, help="write every score here")
     args = parser.parse_args()
     scenes = [s for s in args.scenes.split(",") if s]
@@ -389,7 +409,19 @@ def main() -> None:
         scenes, configs, frames = scenes[:2], [("320x240", 0.05)], 8
         offsets, scale = (0.0, 0.5), 0.5
     t0 = time.perf_counter()
-    scores = run(scenes, offsets, noises, configs, edge_guards, frames, scale)
+    settings = {"default": None, "on": True, "off": False}
+    dropoffs = [settings[v] for v in args.dropoff.split(",")]
+    scores = run(
+        scenes,
+        offsets,
+        noises,
+        configs,
+        edge_guards,
+        frames,
+        scale,
+        dropoffs=dropoffs,
+        open3d=not args.no_open3d,
+    )
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps([asdict(s) for s in scores], indent=1))

@@ -397,7 +397,7 @@ class TsdfConfig:
     @property
     def behind_surface_dropoff(self) -> bool:
         """
-        Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at -mu, so a surface seen from one side does not write a deep negative shell that ghosts when seen from the other side (voxblox's weight drop-off).
+        Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at -mu, so a surface seen from one side does not write a deep negative shell that ghosts when seen from the other side (voxblox's weight drop-off). Off by default: under pose noise it loses surface.
         """
     @behind_surface_dropoff.setter
     def behind_surface_dropoff(self, arg0: bool) -> None: ...

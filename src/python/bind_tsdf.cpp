@@ -225,7 +225,8 @@ void bindTsdf(py::module& m) {
       .def_readwrite("behind_surface_dropoff", &TsdfConfig::behind_surface_dropoff,
                      "Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at "
                      "-mu, so a surface seen from one side does not write a deep negative shell "
-                     "that ghosts when seen from the other side (voxblox's weight drop-off).")
+                     "that ghosts when seen from the other side (voxblox's weight drop-off). "
+                     "Off by default: under pose noise it loses surface.")
       .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad,
                      "Depth images: voxels more than a voxel behind the surface seen by a pixel "
                      "within this angle (rad) of a depth edge (a jump of more than mu) are not "

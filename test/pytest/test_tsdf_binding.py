@@ -156,19 +156,29 @@ def room_tsdf_5cm() -> dp.Tsdf:
 # all on the surface); the mesh is welded since issue 22, and the same ghosts over distinct
 # vertices read 0.060 % at 640x480 / 2 cm (53 of 88,923). The edge guard of issue 22 defect 4
 # (near side only, planes kept, grazing relief) raised 320x240 / 2 cm from under the old bar
-# of 0.06 % to 0.065 % (completeness 0.9995), hence its bar 0.07 %.
+# of 0.06 % to 0.065 % (completeness 0.9995), hence its bar 0.07 %. Those bars hold with
+# behind_surface_dropoff on (the default until 2026-12-04). The default is off since then: under
+# pose noise the drop-off lost surface (docs/tsdf.md), and without it this clean room has more
+# ghosts: 0.079 % (640x480 / 2 cm), 0.082 % (320x240 / 2 cm), 1.22 % (5 cm; legacy 1.25 %),
+# mean error 0.31 / 0.66 / 2.03 mm, completeness 0.9996 / 0.9995 / 0.965.
 BARS = {
-    ("vga", 0.02): (0.0004, 0.997, 0.0007),
-    ("qvga", 0.02): (0.0008, 0.997, 0.0007),
-    ("qvga", 0.05): (0.0025, 0.95, 0.008),
+    ("vga", 0.02, True): (0.0004, 0.997, 0.0007),
+    ("qvga", 0.02, True): (0.0008, 0.997, 0.0007),
+    ("qvga", 0.05, True): (0.0025, 0.95, 0.008),
+    ("vga", 0.02, None): (0.0004, 0.997, 0.0009),
+    ("qvga", 0.02, None): (0.0008, 0.997, 0.0009),
+    ("qvga", 0.05, None): (0.0025, 0.95, 0.014),
 }
 
 
-@pytest.mark.parametrize(("image", "voxel"), list(BARS))
-def test_room_mesh_accuracy(image: str, voxel: float, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("image", "voxel", "dropoff"), list(BARS))
+def test_room_mesh_accuracy(image: str, voxel: float, dropoff: bool | None, tmp_path: Path) -> None:
+    """The room at each size, with the defaults (dropoff None) and with the drop-off on."""
     cam, scene, poses, depths, observed = room_frames(image)
     config = dp.TsdfConfig()
     config.voxel_size_m = voxel
+    if dropoff is not None:
+        config.behind_surface_dropoff = dropoff
     tsdf = dp.Tsdf(config)
     for pose, depth in zip(poses, depths, strict=True):
         tsdf.integrate_depth(depth, camera(cam), pose)
@@ -176,7 +186,7 @@ def test_room_mesh_accuracy(image: str, voxel: float, tmp_path: Path) -> None:
     mesh = tsdf.mesh()
     score = score_mesh(scene, mesh["vertices"], mesh["triangles"], voxel, observed)
     print(image, voxel, score.row())
-    mean_bar, completeness_bar, ghost_bar = BARS[(image, voxel)]
+    mean_bar, completeness_bar, ghost_bar = BARS[(image, voxel, dropoff)]
     health = tsdf.health()
     assert health["crossings"] > 1000
     # Projective distances from oblique views read about 1/cos of the view angle (> 1).
