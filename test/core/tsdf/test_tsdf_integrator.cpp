@@ -634,7 +634,7 @@ double jitteredBoxCompleteness(bool dropoff, double translation_std_m, double ro
 
 TEST(Tsdf, BoxFromJitteredPosesStaysWholeWithoutTheBehindSurfaceDropoff) {
   // Issue 22: under pose noise the behind-surface drop-off lost surface (bench: completeness
-  // 0.59 against 0.77 without it at 640x480 / 2 cm, 2 cm / 0.01 rad), so it is off by default.
+  // 0.56 against 0.77 without it at 640x480 / 2 cm, 2 cm / 0.01 rad), so it is off by default.
   EXPECT_FALSE(TsdfConfig().behind_surface_dropoff);
   // Cameras 3 m from the box, 2 cm / 0.02 rad of pose noise (6 cm at the box), four seeds.
   double complete_default = 0.0, complete_dropoff = 0.0;

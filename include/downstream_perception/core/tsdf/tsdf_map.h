@@ -38,9 +38,9 @@ struct TsdfConfig {
   /// Behind the surface (sdf < -voxel_size_m) the weight falls linearly to 0 at -mu, so a
   /// surface seen from one side does not write a deep negative shell that ghosts when seen from
   /// the other side (voxblox's weight drop-off). Off by default since issue 22: under pose noise
-  /// it loses surface (640x480 / 2 cm, 2 cm / 0.01 rad: completeness 0.59 with it against 0.77
-  /// without, ghosts 46 % against 33 %); without pose noise it halves the few ghosts (0.004
-  /// against 0.009 %). docs/tsdf.md has the figures.
+  /// it loses surface (640x480 / 2 cm, 2 cm / 0.01 rad: completeness 0.56 with it against 0.77
+  /// without, ghosts 51 % against 35 %); without pose noise it has fewer of the few ghosts
+  /// (0.016 against 0.021 %). docs/tsdf.md has the figures.
   bool behind_surface_dropoff = false;
   /// Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle
   /// (rad) of a depth edge are not updated. Rays grazing an object's rim would otherwise write
