@@ -402,6 +402,15 @@ class TsdfConfig:
     @behind_surface_dropoff.setter
     def behind_surface_dropoff(self, arg0: bool) -> None: ...
     @property
+    def behind_surface_dropoff_start_voxels(self) -> float:
+        """
+        With behind_surface_dropoff, the weight stays 1 up to this many voxels behind the surface, then falls linearly to 0 at -mu (1 = voxblox's ramp; >= truncation_voxels = no ramp).
+        """
+    @behind_surface_dropoff_start_voxels.setter
+    def behind_surface_dropoff_start_voxels(
+        self, arg0: typing.SupportsFloat | typing.SupportsIndex
+    ) -> None: ...
+    @property
     def carve_free_space(self) -> bool:
         """
         Update the voxels along the whole ray from the sensor, not only the truncation band: an object that moved away is erased where its free space is seen again (voxblox's voxel carving). Off by default: it allocates blocks for all the free space in view, so memory and time grow with the range. Carving stays inside the camera's view frustum up to max_depth_m (PinholeCamera::validate refuses intrinsics whose frustum is absurdly wide or off-axis).

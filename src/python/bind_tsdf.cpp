@@ -227,6 +227,11 @@ void bindTsdf(py::module& m) {
                      "-mu, so a surface seen from one side does not write a deep negative shell "
                      "that ghosts when seen from the other side (voxblox's weight drop-off). "
                      "Off by default: under pose noise it loses surface.")
+      .def_readwrite("behind_surface_dropoff_start_voxels",
+                     &TsdfConfig::behind_surface_dropoff_start_voxels,
+                     "With behind_surface_dropoff, the weight stays 1 up to this many voxels "
+                     "behind the surface, then falls linearly to 0 at -mu (1 = voxblox's ramp; "
+                     ">= truncation_voxels = no ramp).")
       .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad,
                      "Depth images: voxels more than a voxel behind the surface seen by a pixel "
                      "within this angle (rad) of a depth edge (a jump of more than mu) are not "

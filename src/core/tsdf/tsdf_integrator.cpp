@@ -51,24 +51,26 @@ class ObservationWeight {
  public:
   ObservationWeight(const TsdfConfig& c, float mu)
       : inverse_square_(c.weighting == TsdfConfig::Weighting::kInverseSquareDepth),
-        dropoff_(c.behind_surface_dropoff),
-        s_(static_cast<float>(c.voxel_size_m)),
+        // A start at or beyond mu leaves nothing to ramp (and 1 / (mu - start) would be <= 0).
+        dropoff_(c.behind_surface_dropoff &&
+                 c.behind_surface_dropoff_start_voxels * c.voxel_size_m < static_cast<double>(mu)),
+        start_(static_cast<float>(c.behind_surface_dropoff_start_voxels * c.voxel_size_m)),
         mu_(mu),
-        inv_dropoff_span_(1.0f / (mu - s_)) {}
+        inv_dropoff_span_(dropoff_ ? 1.0f / (mu - start_) : 0.0f) {}
   /// Branch-free (selects only), so a loop calling it vectorises.
   float operator()(float z, float sdf) const {
     const float w = inverse_square_ ? 1.0f / (z * z) : 1.0f;
     const float dropped = w * ((mu_ + sdf) * inv_dropoff_span_);
-    return dropoff_ & (sdf < -s_) ? dropped : w;
+    return dropoff_ & (sdf < -start_) ? dropped : w;
   }
 
  private:
   bool inverse_square_;
   bool dropoff_;
-  float s_;
+  float start_;  ///< m behind the surface where the ramp starts
   float mu_;
-  /// 1 / (mu - s): infinite when mu = s (truncation_voxels 1), but then no voxel with
-  /// sdf < -s = -mu reaches the drop-off (both integrators skip sdf < -mu first).
+  /// 1 / (mu - start); only used with dropoff_, where mu > start. Both integrators skip
+  /// sdf < -mu first, so the ramp never goes negative.
   float inv_dropoff_span_;
 };
 

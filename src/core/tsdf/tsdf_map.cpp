@@ -29,6 +29,11 @@ std::string TsdfConfig::validate() const {
     why << "edge_guard_rad must be in [0, 0.2) rad, got " << edge_guard_rad;
   } else if (!(edge_guard_grazing_voxels >= 1.0 && edge_guard_grazing_voxels <= 1000.0)) {
     why << "edge_guard_grazing_voxels must be in [1, 1000], got " << edge_guard_grazing_voxels;
+  } else if (!(std::isfinite(behind_surface_dropoff_start_voxels) &&
+               behind_surface_dropoff_start_voxels >= 0.0)) {
+    why << "behind_surface_dropoff_start_voxels must be finite and >= 0 (>= truncation_voxels = "
+           "no ramp), got "
+        << behind_surface_dropoff_start_voxels;
   } else if (max_blocks < 1) {
     why << "max_blocks must be >= 1";
   } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {

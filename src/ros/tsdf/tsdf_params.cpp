@@ -22,6 +22,8 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   pnh.param("truncation_voxels", c.truncation_voxels, c.truncation_voxels);
   pnh.param("max_weight", c.max_weight, c.max_weight);
   pnh.param("behind_surface_dropoff", c.behind_surface_dropoff, c.behind_surface_dropoff);
+  pnh.param("behind_surface_dropoff_start_voxels", c.behind_surface_dropoff_start_voxels,
+            c.behind_surface_dropoff_start_voxels);
   pnh.param("interpolate_depth", c.interpolate_depth, c.interpolate_depth);
   pnh.param("carve_free_space", c.carve_free_space, c.carve_free_space);
   pnh.param("no_return_carve_min_valid_fraction", c.no_return_carve_min_valid_fraction,

@@ -42,6 +42,11 @@ struct TsdfConfig {
   /// without, ghosts 51 % against 35 %); without pose noise it has fewer of the few ghosts
   /// (0.016 against 0.021 %). docs/tsdf.md has the figures.
   bool behind_surface_dropoff = false;
+  /// With behind_surface_dropoff, the weight stays 1 up to this many voxels behind the surface
+  /// (sdf = -start * voxel_size_m), then falls linearly to 0 at -mu. 1 = voxblox's ramp (the
+  /// default before issue 22); later starts land between that and no ramp (docs/tsdf.md). A value
+  /// >= truncation_voxels means no ramp (like behind_surface_dropoff false).
+  double behind_surface_dropoff_start_voxels = 1.0;
   /// Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle
   /// (rad) of a depth edge are not updated. Rays grazing an object's rim would otherwise write
   /// "inside" values into the free space beyond its edges (the projective TSDF's ghost
