@@ -22,11 +22,6 @@ constexpr std::size_t kMaxMarkGridBlocks = std::size_t{1} << 22;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-std::uint8_t stateOf(const TsdfVoxel& v, float min_weight) {
-  if (!(v.weight > min_weight)) return static_cast<std::uint8_t>(EsdfState::kUnknown);
-  return static_cast<std::uint8_t>(v.distance < 0.0f ? EsdfState::kOccupied : EsdfState::kFree);
-}
-
 std::size_t volume(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) {
   if ((hi.array() < lo.array()).any()) return 0;
   const Eigen::Vector3i n = hi - lo + Eigen::Vector3i::Ones();
@@ -75,6 +70,11 @@ std::string EsdfConfig::validate(double voxel_size_m) const {
   return why.str();
 }
 
+EsdfState esdfStateOf(const TsdfVoxel& v, float min_weight) {
+  if (!(v.weight > min_weight)) return EsdfState::kUnknown;
+  return v.distance < 0.0f ? EsdfState::kOccupied : EsdfState::kFree;
+}
+
 float esdfMetres(std::int32_t squared_voxels, bool occupied, double voxel_size_m,
                  double max_distance_m) {
   const double magnitude =
@@ -117,7 +117,7 @@ std::size_t Esdf::readBlock(const TsdfMap& map, const Eigen::Vector3i& key, cons
   const float min_weight = static_cast<float>(map.config().min_weight);
   std::size_t differ = 0;
   for (int i = 0; i < kTsdfBlockVoxels; ++i) {
-    const std::uint8_t s = stateOf(block.voxels[i], min_weight);
+    const auto s = static_cast<std::uint8_t>(esdfStateOf(block.voxels[i], min_weight));
     differ += s != esdf->state[i];
     esdf->state[i] = s;
   }
@@ -230,6 +230,10 @@ std::vector<Eigen::Vector3i> Esdf::blocksToWrite(const std::vector<Eigen::Vector
     for (const Eigen::Vector3i& k : changed) {
       const Eigen::Vector3i a = (k - reach).cwiseMax(lo) - lo;
       const Eigen::Vector3i b = (k + reach).cwiseMin(hi) - lo;
+      // A block the TSDF dropped may lie beyond the map's extent on some axis (a cleared map
+      // integrated again elsewhere): its reach then misses the grid, and the fill below would
+      // run from past the end of a row.
+      if ((a.array() > b.array()).any()) continue;
       for (int z = a.z(); z <= b.z(); ++z) {
         for (int y = a.y(); y <= b.y(); ++y) {
           std::uint8_t* row = mark.data() + (static_cast<std::size_t>(z) * n.y() + y) * n.x();

@@ -238,6 +238,31 @@ TEST(Esdf, EvictedAndClearedBlocksLeaveTheField) {
   EXPECT_EQ(esdf.blockCount(), 0u);
 }
 
+TEST(Esdf, AClearedMapIntegratedAgainElsewhereUpdatesIncrementally) {
+  // Found by the fuzz campaign: after a clear, the dropped blocks are changes, and those beyond
+  // the new blocks' extent along x only (same y and z) made the reach marking fill a row from
+  // past its end (a crash or heap damage). Now they are skipped, and the field is exact.
+  TsdfConfig tc;
+  tc.voxel_size_m = 0.1;
+  TsdfMap map(tc);
+  const double mu = tc.truncation();
+  const auto slab = [&](const Eigen::Vector3d& p) {
+    return std::clamp((p.z() - 0.237) / mu, -1.0, 1.0);
+  };
+  fill(&map, {0, 0, -3}, {15, 15, 12}, slab);  // blocks x, y 0..1
+  Esdf esdf(EsdfConfig{}, 0.1);                // 1 m: a reach of 2 blocks
+  EXPECT_TRUE(esdf.update(map).full);
+  map.clear();
+  fill(&map, {64, 0, -3}, {79, 15, 12}, slab);  // blocks x 8..9: 6 blocks beyond the reach
+  const EsdfUpdateStats stats = esdf.update(map);
+  EXPECT_FALSE(stats.full);
+  EXPECT_GT(stats.blocks_removed, 0u);
+  EXPECT_EQ(esdf.blockCount(), map.blockCount());
+  const OracleComparison o = compareWithOracle(map, esdf);
+  EXPECT_EQ(o.off, 0u);
+  EXPECT_GT(o.known, 4000u);
+}
+
 TEST(Esdf, PlaneDistanceAndGradientAreExact) {
   // Floor plane z = 0.237 m at 10 cm voxels: voxels k <= 2 are occupied (centres below it), the
   // first free layer is k = 3. A free voxel k is k - 2 voxels above the nearest occupied one:

@@ -68,6 +68,10 @@ struct EsdfSample {
   Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  ///< of that trilinear interpolant
 };
 
+/// A voxel's state as the ESDF reads it from the TSDF: unknown at weight <= min_weight, else
+/// occupied when D < 0, free otherwise.
+EsdfState esdfStateOf(const TsdfVoxel& voxel, float min_weight);
+
 /// The stored value of a voxel whose exact squared lattice distance to the nearest seed is
 /// `squared_voxels` (kEdtFarSquared: none within the cap): (sqrt(k) - 1/2) * voxel_size_m,
 /// clamped at max_distance_m, negative for an occupied voxel.
