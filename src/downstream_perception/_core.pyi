@@ -584,6 +584,15 @@ class Tsdf:
         """
         Forgets every block, the mesh and the ESDF.
         """
+    def esdf_band_slice(
+        self,
+        min_z_m: typing.SupportsFloat | typing.SupportsIndex = 0.05,
+        max_z_m: typing.SupportsFloat | typing.SupportsIndex = 1.8,
+        max_distance_m: typing.SupportsFloat | typing.SupportsIndex = 2.0,
+    ) -> dict:
+        """
+        The height band's 2-D ESDF (what the nodelet publishes as ~slice_distance): a column is occupied when a voxel of the band (centres in [min_z_m, max_z_m], m) over it is occupied (D < 0, the ESDF's rule), free when it has only free and unknown ones. dict of grid (GridGeometry, the cells of Tsdf.slice over the map) and distance (float32 [y, x], m): (sqrt(k) - 1/2) * voxel size to the nearest occupied column (k in squared voxels), negative on occupied columns (to the nearest free one), clamped at max_distance_m, NaN on unknown columns; columns_occupied, columns_free. Read from the map now (no esdf_update needed). Raises ValueError on an inverted band or a cap outside [one voxel, 1e6] m.
+        """
     def esdf_distance(
         self, points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 3]"]
     ) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:

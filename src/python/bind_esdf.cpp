@@ -4,12 +4,14 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
 #include "downstream_perception/core/tsdf/esdf.h"
+#include "downstream_perception/core/tsdf/esdf_band.h"
 #include "tsdf_object.h"
 
 namespace py = pybind11;
@@ -144,6 +146,40 @@ void bindEsdf(py::module& m) {
           "esdf_voxels", [](Tsdf& self) { return knownVoxels(esdfOf(self)); },
           "Every known ESDF voxel: dict of voxels (N, 3) int32 lattice indices (centre = index "
           "* voxel_size_m), distance (N,) float32 m, occupied (N,) int8.")
+      .def(
+          "esdf_band_slice",
+          [](const Tsdf& self, double min_z_m, double max_z_m, double max_distance_m) {
+            EsdfBandConfig c;
+            c.min_z_m = min_z_m;
+            c.max_z_m = max_z_m;
+            c.max_distance_m = max_distance_m;
+            const std::string why = c.validate(self.map.voxelSize());
+            if (!why.empty()) throw std::invalid_argument("esdf_band_slice: " + why);
+            EsdfBandSlice band;
+            {
+              py::gil_scoped_release release;
+              band = esdfBandSlice(self.map, c);
+            }
+            py::array_t<float> distance({static_cast<py::ssize_t>(band.grid.sizeY()),
+                                         static_cast<py::ssize_t>(band.grid.sizeX())});
+            std::copy(band.distance_m.begin(), band.distance_m.end(), distance.mutable_data());
+            py::dict out;
+            out["grid"] = band.grid;
+            out["distance"] = distance;
+            out["columns_occupied"] = band.stats.columns_occupied;
+            out["columns_free"] = band.stats.columns_free;
+            return out;
+          },
+          py::arg("min_z_m") = 0.05, py::arg("max_z_m") = 1.8, py::arg("max_distance_m") = 2.0,
+          "The height band's 2-D ESDF (what the nodelet publishes as ~slice_distance): a column "
+          "is occupied when a voxel of the band (centres in [min_z_m, max_z_m], m) over it is "
+          "occupied (D < 0, the ESDF's rule), free when it has only free and unknown ones. dict "
+          "of grid (GridGeometry, the cells of Tsdf.slice over the map) and distance (float32 "
+          "[y, x], m): (sqrt(k) - 1/2) * voxel size to the nearest occupied column (k in "
+          "squared voxels), negative on occupied columns (to the nearest free one), clamped at "
+          "max_distance_m, NaN on unknown columns; columns_occupied, columns_free. Read from "
+          "the map now (no esdf_update needed). Raises ValueError on an inverted band or a cap "
+          "outside [one voxel, 1e6] m.")
       .def_property_readonly(
           "esdf_block_count", [](Tsdf& self) { return esdfOf(self).blockCount(); },
           "ESDF blocks (at most one per TSDF block)")

@@ -1406,6 +1406,7 @@ def gen_esdf(rng: np.random.Generator) -> dict[str, Any]:
         "max_distance_m": g.f(0.1, 2.0, 0.3),
         "ops": ops,
         "query": sample_points(g),
+        "band": (g.f(-1, 1), g.f(0.5, 3), g.f(0.05, 3)),  # min_z_m, max_z_m, max_distance_m
     }
 
 
@@ -1452,8 +1453,23 @@ def call_esdf(a: dict[str, Any]) -> Any:
     tsdf.esdf_update()
     distance, gradient = tsdf.esdf_distance(a["query"])
     voxels = tsdf.esdf_voxels()
+    lo, hi, band_cap = a["band"]
+    band_valid = (
+        all(math.isfinite(v) for v in a["band"])
+        and lo < hi
+        and config.voxel_size_m <= band_cap <= 1e6
+    )
+    try:
+        band = tsdf.esdf_band_slice(lo, hi, band_cap)
+        if not band_valid:
+            problems.append(f"esdf_band_slice accepted band {a['band']}")
+    except ValueError as error:
+        if band_valid or not str(error):
+            raise
+        band = None
     return {
         "problems": problems,
+        "band": band,
         "max": max_distance[-1],
         "distance": distance,
         "gradient": gradient,
@@ -1469,6 +1485,19 @@ def garbage_esdf(a: dict[str, Any], r: Any) -> str | None:
         return r["problems"][0]
     if r["blocks"][0] > r["blocks"][1]:
         return f"{r['blocks'][0]} ESDF blocks for {r['blocks'][1]} TSDF blocks"
+    band = r["band"]
+    if band is not None:
+        d = band["distance"]
+        if d.shape != (band["grid"].size_y, band["grid"].size_x):
+            return f"band slice {d.shape} for a {band['grid']}"
+        known = d[np.isfinite(d)]
+        if np.isinf(d).any() or (np.abs(known) > a["band"][2] + 1e-6).any():
+            return "a band slice distance that is infinite or beyond its cap"
+        if (band["columns_occupied"], band["columns_free"]) != (
+            int((known < 0).sum()),
+            int((known > 0).sum()),
+        ):
+            return "band slice column counts disagree with its signs"
     v = r["voxel_distance"]
     if not (np.isfinite(v) & (np.abs(v) <= r["max"] + 1e-6)).all():
         return "a known ESDF voxel that is not finite or beyond the cap"

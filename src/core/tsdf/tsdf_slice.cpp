@@ -22,6 +22,11 @@ std::string TsdfSliceConfig::validate() const {
   return why.str();
 }
 
+VoxelLayers bandLayers(double min_z_m, double max_z_m, double voxel_size_m) {
+  return {static_cast<int>(std::ceil(min_z_m / voxel_size_m)),
+          static_cast<int>(std::floor(max_z_m / voxel_size_m))};
+}
+
 GridGeometry sliceGeometry(const TsdfMap& map) {
   if (map.blockCount() == 0) return GridGeometry();
   Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max());
@@ -48,9 +53,9 @@ std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
   const float min_weight = static_cast<float>(map.config().min_weight);
   const float occupied_below =
       static_cast<float>((config.occupied_distance_m < 0.0 ? s : config.occupied_distance_m) / mu);
-  // Voxel z indices in the band (centres at k * s).
-  const int k_min = static_cast<int>(std::ceil(config.min_z_m / s));
-  const int k_max = static_cast<int>(std::floor(config.max_z_m / s));
+  const VoxelLayers layers = bandLayers(config.min_z_m, config.max_z_m, s);
+  const int k_min = layers.first;
+  const int k_max = layers.last;
   for (const auto& [key, block] : map.blocks()) {
     const int z0 = key.z() * kTsdfBlockSide;
     if (z0 + kTsdfBlockSide - 1 < k_min || z0 > k_max) continue;

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "downstream_perception/core/tsdf/esdf_band.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/ros/common/config_errors.h"
@@ -46,6 +47,13 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   slice_ = settings.slice;
   slice_distance_max_m_ = settings.slice_distance_max_m;
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
+  if (slice_distance_max_m_ > 0.0 && slice_distance_max_m_ < map_->voxelSize()) {
+    // The band's ESDF needs a cap of a voxel at least (its nearest value is half a voxel).
+    config_errors_.add("parameter ~slice_distance_max_m = " + toText(slice_distance_max_m_) +
+                       " is below one voxel; using one voxel (" + toText(map_->voxelSize()) +
+                       " m)");
+    slice_distance_max_m_ = map_->voxelSize();
+  }
   const OctomapSettings octomap = readOctomapSettings(pnh_, map_->config(), &config_errors_);
   if (settings.esdf_max_distance_m > 0.0) {
     EsdfConfig esdf;
@@ -302,10 +310,7 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
 void TsdfRos::publishMesh(const ros::TimerEvent&) {
   visualization_msgs::MarkerArray markers;
   nav_msgs::OccupancyGridPtr slice;
-  std::vector<SliceCell> slice_cells;
-  GridGeometry slice_geometry;
-  double slice_z = 0.0;
-  sensor_msgs::PointCloud2Ptr occupied, esdf_slice;
+  sensor_msgs::PointCloud2Ptr occupied, esdf_slice, slice_distance;
   std_msgs::Header header;
   header.frame_id = world_frame_;
   header.stamp = ros::Time::now();
@@ -317,13 +322,7 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     markers = markers_.changed(mesher_, header);
     if (!mesher_.lastUpdated().empty() || !markers.markers.empty() || slice_changed_) {
-      slice_geometry = sliceGeometry(*map_);
-      if (slice_geometry.sizeX() > 0) {
-        slice_cells = sliceTsdf(*map_, slice_geometry, slice_, &slice_stats_);
-      }
-      slice_z = slice_.min_z_m;
-      slice = sliceGridMessage(slice_cells, slice_geometry, slice_z, header);
-      slice_changed_ = false;
+      sliceLocked(header, &slice, &slice_distance);
     }
     if (esdf_) esdf_slice = esdf_->sliceLocked(header);
     mesh_triangles_ = 0;
@@ -341,16 +340,38 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   if (octree_ && octree_->takeChanged()) occupied = occupiedCloud(header);
   if (!markers.markers.empty()) mesh_publisher_.publish(markers);
   if (slice) slice_publisher_.publish(slice);
-  // The clearance map only while someone listens (latched: a late subscriber gets the next).
-  if (slice && slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
-    slice_distance_publisher_.publish(
-        sliceDistanceCloud(sliceDistance(slice_cells, slice_geometry, slice_distance_max_m_),
-                           slice_geometry, slice_z, header));
-  }
+  if (slice_distance) slice_distance_publisher_.publish(slice_distance);
   if (occupied) octomap_publisher_.publish(occupied);
   if (esdf_slice) esdf_->publish(esdf_slice);
   returnFreeMemory();
   diagnostics_.update();
+}
+
+void TsdfRos::sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGridPtr* slice,
+                          sensor_msgs::PointCloud2Ptr* distance) {
+  slice_changed_ = false;
+  GridGeometry grid;
+  try {
+    grid = sliceGeometry(*map_);
+  } catch (const std::invalid_argument& error) {
+    // Blocks kilometres apart (a long drive at fine voxels): no grid can hold their extent.
+    ++slices_refused_;
+    ROS_WARN_THROTTLE(10.0, "tsdf: no slice this tick: %s", error.what());
+    return;
+  }
+  std::vector<SliceCell> cells;
+  if (grid.sizeX() > 0) cells = sliceTsdf(*map_, grid, slice_, &slice_stats_);
+  *slice = sliceGridMessage(cells, grid, slice_.min_z_m, header);
+  // The clearance only while someone listens (latched: a late subscriber gets the next): the
+  // band's ESDF over the slice's cells (esdf_band.h), not a second distance mechanism.
+  if (slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
+    EsdfBandConfig band;
+    band.min_z_m = slice_.min_z_m;
+    band.max_z_m = slice_.max_z_m;
+    band.max_distance_m = slice_distance_max_m_;
+    const EsdfBandSlice clearance = esdfBandSlice(*map_, band);
+    *distance = sliceDistanceCloud(clearance.distance_m, clearance.grid, band.min_z_m, header);
+  }
 }
 
 void TsdfRos::returnFreeMemory() {
@@ -473,6 +494,7 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     status.add("octomap: insertion time max (ms)", octree.insert_ms.max);
   }
   status.add("slice: free cells", slice_stats_.cells_free);
+  status.add("slices refused (map extent beyond a grid)", slices_refused_);
   if (esdf_) esdf_->diagnose(status);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());
   if (!last_health_.isZero()) {

@@ -16,6 +16,7 @@ import unittest
 import numpy as np
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Point
 from sensor_msgs import point_cloud2
 from sensor_msgs.msg import PointCloud2
@@ -40,6 +41,19 @@ class TsdfEsdfTest(unittest.TestCase):
         def on_slice(msg: PointCloud2) -> None:
             cls.slice = msg
 
+        cls.band: PointCloud2 | None = None
+        cls.status: dict[str, str] = {}
+
+        def on_band(msg: PointCloud2) -> None:
+            cls.band = msg
+
+        def on_diag(msg: DiagnosticArray) -> None:
+            for s in msg.status:
+                if s.name.endswith("tsdf: tsdf"):
+                    cls.status = {kv.key: kv.value for kv in s.values}
+
+        rospy.Subscriber("/tsdf/slice_distance", PointCloud2, on_band, queue_size=1)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=20)
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
         rospy.Subscriber("/tsdf/esdf_slice", PointCloud2, on_slice, queue_size=1)
         rospy.wait_for_service("/tsdf/esdf_distance", 20.0)
@@ -77,6 +91,23 @@ class TsdfEsdfTest(unittest.TestCase):
         d, _, observed = self.distances(sample[:, :3])
         self.assertGreater(int(observed.sum()), len(sample) // 2)
         np.testing.assert_allclose(d[observed], sample[observed, 3], atol=1e-6)
+
+    def test_3_a_slice_clearance_cap_below_a_voxel_is_raised_to_one(self) -> None:
+        # ~slice_distance_max_m 0.01 with 5 cm voxels: a config error, and the band's ESDF
+        # capped at one voxel, so a free column reads (sqrt(k) - 1/2) * 5 cm for k = 1 (beside
+        # an obstacle) or 2 (diagonal to one), the cap for any farther, occupied ones the same
+        # towards free columns, negative.
+        self.assertTrue(wait_until(lambda: self.done, 40.0), "the simulator did not finish")
+        self.assertTrue(wait_until(lambda: self.band is not None, 10.0), "no ~slice_distance")
+        self.assertTrue(wait_until(lambda: "config errors" in self.status, 10.0), self.status)
+        self.assertEqual(self.status["slice distance cap (m)"], "0.05", self.status)
+        self.assertGreaterEqual(int(self.status["config errors"]), 1)
+        d = np.array([p[0] for p in point_cloud2.read_points(self.band, ("distance",))])
+        self.assertGreater(len(d), 1000)
+        values = set(np.round(d, 6).tolist())
+        diagonal = round((np.sqrt(2.0) - 0.5) * 0.05, 6)
+        self.assertLessEqual(values, {-0.05, -diagonal, -0.025, 0.025, diagonal, 0.05})
+        self.assertLessEqual({-0.025, 0.025, 0.05}, values)
 
 
 if __name__ == "__main__":

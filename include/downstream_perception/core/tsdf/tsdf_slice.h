@@ -30,6 +30,14 @@ struct TsdfSliceStats {
   std::size_t cells_free = 0;
 };
 
+/// The voxel layers (z indices) whose centres, k * voxel_size_m, lie in [min_z_m, max_z_m]: the
+/// band of the slice and of the band's ESDF (esdf_band.h). Empty when first > last.
+struct VoxelLayers {
+  int first = 0;
+  int last = -1;
+};
+VoxelLayers bandLayers(double min_z_m, double max_z_m, double voxel_size_m);
+
 /// A grid over the x-y extent of the allocated blocks with one cell per voxel column (voxel
 /// centres in the middle of the cells). Invalid (0 x 0) for an empty map.
 GridGeometry sliceGeometry(const TsdfMap& map);

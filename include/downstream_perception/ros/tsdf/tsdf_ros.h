@@ -66,6 +66,10 @@ class TsdfRos {
                       const std::string& what, int queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
+  /// Under mutex_: the slice and, while someone listens, its clearance (the band's ESDF); leaves
+  /// both null and counts slices_refused_ when the map's extent fits no grid.
+  void sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGridPtr* slice,
+                   sensor_msgs::PointCloud2Ptr* distance);
   /// malloc_trim every kTrimPeriodS (on the mesh timer): freed memory goes back to the OS.
   void returnFreeMemory();
   static constexpr int kTrimPeriodS = 5;
@@ -123,6 +127,7 @@ class TsdfRos {
   TsdfIntegrationStats last_;
   std::size_t pixels_invalid_ = 0;
   std::size_t blocks_refused_ = 0;
+  std::size_t slices_refused_ = 0;  ///< mesh ticks whose map extent fits no slice grid
   std::size_t blocks_evicted_ = 0;
   std::size_t pixels_no_return_ignored_ = 0;  ///< +Inf pixels carving refused to use (total)
   TimingStats integrate_ms_;

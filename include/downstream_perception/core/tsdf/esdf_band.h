@@ -1,0 +1,54 @@
+// The ESDF of a height band, in 2-D: the clearance a ground robot whose body spans the band
+// (slice_min_z_m .. slice_max_z_m) has at each voxel column. It is the ESDF's own mechanism
+// restricted to the band, not a second one: the same voxel states (esdfStateOf: unknown at
+// weight <= min_weight, occupied at D < 0, else free), the same exact bounded transform
+// (boundedSquaredDistances3d, here one layer deep) and the same values (esdfMetres:
+// (sqrt(k) - 1/2) * voxel size, negative inside, clamped). Only the seeds differ: a column is
+// occupied when any voxel of the band over it is occupied, free when it has a free band voxel
+// and no occupied one, unknown otherwise. So the floor under the band, and anything above it,
+// is no obstacle (the 3-D ESDF's minimum over the band would read the floor's few centimetres
+// everywhere). For a free column with every band voxel known this is exactly the minimum over
+// the band's layers of the 3-D ESDF seeded by the band's occupied voxels alone.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "downstream_perception/core/grid/grid_geometry.h"
+#include "downstream_perception/core/tsdf/tsdf_map.h"
+
+namespace downstream_perception {
+
+struct EsdfBandConfig {
+  double min_z_m = 0.05;        ///< band bottom (map frame, m): above the floor
+  double max_z_m = 1.8;         ///< band top (m): the robot's height
+  double max_distance_m = 2.0;  ///< clamp of the distances (m)
+  /// Empty if valid for voxels of voxel_size_m, else the reason: finite min_z_m < max_z_m;
+  /// max_distance_m finite, at least one voxel (as the ESDF's: a smaller cap would clamp every
+  /// value, even the half voxel next to an obstacle) and at most kMaxDistanceM.
+  std::string validate(double voxel_size_m) const;
+  static constexpr double kMaxDistanceM = 1e6;  ///< distances are float32
+};
+
+struct EsdfBandStats {
+  std::size_t columns_occupied = 0;
+  std::size_t columns_free = 0;
+  std::size_t voxels_in_band = 0;  ///< known voxels of the band read
+};
+
+struct EsdfBandSlice {
+  /// sliceGeometry(map): one cell per voxel column, the same cells as sliceTsdf's.
+  GridGeometry grid;
+  /// Row-major over `grid` (m): > 0 free (distance to the nearest occupied column), < 0
+  /// occupied (to the nearest free column), NaN unknown; magnitudes clamped at max_distance_m.
+  std::vector<float> distance_m;
+  EsdfBandStats stats;
+};
+
+/// The band's 2-D ESDF over sliceGeometry(map) (an empty grid for an empty map). Throws
+/// std::invalid_argument if config.validate(map.voxelSize()) fails or the map's x-y extent fits
+/// no GridGeometry (sliceGeometry's limits).
+EsdfBandSlice esdfBandSlice(const TsdfMap& map, const EsdfBandConfig& config);
+
+}  // namespace downstream_perception
