@@ -28,7 +28,8 @@ void CostmapPublisher::sendCurrent(const ros::SingleSubscriberPublisher& subscri
   std::lock_guard<std::mutex> lock(source_mutex_);
   if (!new_subscriber_source_) return;
   nav_msgs::OccupancyGrid msg;
-  if (new_subscriber_source_(&msg)) subscriber.publish(msg);
+  new_subscriber_source_(&msg);
+  subscriber.publish(msg);
 }
 
 void CostmapPublisher::toMessage(const Costmap& costmap, const std::string& frame_id,

@@ -44,7 +44,6 @@ CostmapRos::CostmapRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     std::lock_guard<std::recursive_mutex> lock(layered_costmap_->mutex());
     CostmapPublisher::toMessage(layered_costmap_->costmap(), config_.global_frame, ros::Time::now(),
                                 msg);
-    return true;
   });
   clear_service_ = pnh_.advertiseService("clear", &CostmapRos::clearService, this);
   update_timer_ = nh_.createTimer(ros::Duration(1.0 / config_.update_frequency),

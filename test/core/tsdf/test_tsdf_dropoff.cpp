@@ -3,17 +3,10 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
-#include <algorithm>
 #include <cmath>
-#include <limits>
-#include <map>
-#include <random>
-#include <set>
-#include <tuple>
 #include <utility>
 #include <vector>
 
-#include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "tsdf_test_helpers.h"

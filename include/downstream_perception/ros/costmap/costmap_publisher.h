@@ -27,8 +27,8 @@ class CostmapPublisher {
   /// update, or nothing if it is empty.
   void publish(const Costmap& costmap, const ros::Time& stamp, const CellBounds& changed);
   void setAlwaysSendFull(bool always) { always_send_full_ = always; }
-  /// Fills the current grid for a new subscriber of <topic>, or returns false (nothing to send).
-  using GridSource = std::function<bool(nav_msgs::OccupancyGrid*)>;
+  /// Fills the current grid for a new subscriber of <topic>.
+  using GridSource = std::function<void(nav_msgs::OccupancyGrid*)>;
   /// When set, each new subscriber of <topic> gets the grid `source` fills at once, sent to it
   /// alone: costmap_2d's Costmap2DPublisher::onNewSubscription, which is how a costmap with
   /// publish_frequency 0 (Fetch's global costmap) still reaches rviz or a planner.
