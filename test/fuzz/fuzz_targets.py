@@ -2029,7 +2029,7 @@ def call_voxel_ray(a: dict[str, Any]) -> Any:
 
 
 def garbage_voxel_ray(a: dict[str, Any], cells: Any) -> str | None:
-    box = np.asarray(a["box"]).astype(np.int64)
+    box = np.asarray(a["box"]).astype(np.int64).reshape(-1)  # (3,) or (3, 1): both accepted
     if cells.size == 0:
         return None
     if (cells < 0).any() or (cells >= box).any():
