@@ -14,8 +14,8 @@
 namespace downstream_perception {
 
 namespace {
-// The transform's squared radius must stay below kEdtFarSquared in int32: a cap beyond this many
-// voxels (100 m at 2.2 mm voxels) reads the cap from here on.
+// The transform's squared radius must stay below kEdtFarSquared in int32. A cap beyond this many
+// voxels (the nodelet's largest, 100 m, at voxels under 3.1 mm) reads the cap from here on.
 constexpr int kMaxRadiusVoxels = 32000;
 }  // namespace
 
