@@ -854,6 +854,147 @@ std::size_t walkRaysInBands(const ScanCells& sc, const Blocks& blocks, RayWalkKi
   return walked;
 }
 
+
+// --- Reverse query (ClearingWalk::kReverseQuery, issue 20 spike) ---
+
+// A pseudo-angle of the direction (dx, dy) in [0, 4): monotone in atan2 over a turn starting at
+// +x (the "diamond angle"), one division, no trigonometry. Not defined at (0, 0).
+inline double pseudoAngle(double dx, double dy) {
+  if (dy >= 0) return dx >= 0 ? dy / (dx + dy) : 1.0 - dx / (dy - dx);
+  return dx < 0 ? 2.0 - dy / (-dx - dy) : 3.0 + dx / (dx - dy);
+}
+
+// Whether the walk of `ray` (no corners) visits cell (x, y) and clears it: a cell before its end
+// cell, or its end cell when the ray clears that too. The walk reaches (a, b) (x and y steps from
+// its start) exactly when its a-th x crossing comes before its (b+1)-th y crossing and its b-th y
+// crossing before its (a+1)-th x crossing; the (a'+1)-th x crossing comes before the (b'+1)-th y
+// crossing exactly when err + a' esx - b' esy <= 0 (blockExit's order rule). In 128 bits.
+inline bool rayClears(const ClearingRay& ray, int x, int y) {
+  const RayWalk& w = ray.walk;
+  const int a = (x - w.cx) * w.sx;
+  const int b = (y - w.cy) * w.sy;
+  if (a < 0 || b < 0 || a > w.steps_x || b > w.steps_y) return false;
+  const int n = a + b;
+  const int left = w.stepsLeft();
+  if (n == left) return ray.clear_end_cell;  // the end cell (a, b both at their ends)
+  if (a > 0 && static_cast<Int128>(w.err) + static_cast<Int128>(a - 1) * w.err_step_x -
+                       static_cast<Int128>(b) * w.err_step_y >
+                   0) {
+    return false;
+  }
+  if (b > 0 && static_cast<Int128>(w.err) + static_cast<Int128>(a) * w.err_step_x -
+                       static_cast<Int128>(b - 1) * w.err_step_y <=
+                   0) {
+    return false;
+  }
+  return true;
+}
+
+// Pass 2 by reverse query (see ClearingWalk::kReverseQuery); returns the cells walked (the
+// rays' cells, counted as the per-ray walk counts them). rays_fixed: per ray fx0, fy0, dx, dy.
+std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, IntegrationScratch* s) {
+  const std::vector<ClearingRay>& rays = s->rays;
+  const std::int64_t* fixed = s->ray_fixed.data();
+  std::vector<IntegrationScratch::DirectedRay>& dir = s->directed;
+  std::vector<ClearingRay>& aside = s->rays_aside;
+  dir.clear();
+  aside.clear();
+  std::size_t walked = 0;
+  if (rays.empty()) return 0;
+  const std::int64_t ox = fixed[0];
+  const std::int64_t oy = fixed[1];
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const ClearingRay& ray = rays[i];
+    const std::int64_t* f = fixed + 4 * i;
+    if (ray.walk.corners || f[0] != ox || f[1] != oy || ray.walk.stepsLeft() == 0) {
+      aside.push_back(ray);
+      continue;
+    }
+    walked += static_cast<std::size_t>(ray.walk.stepsLeft()) + (ray.clear_end_cell ? 1 : 0);
+    dir.push_back({pseudoAngle(static_cast<double>(f[2]), static_cast<double>(f[3])),
+                   static_cast<std::uint32_t>(i)});
+  }
+  // The other rays first, per ray (any order: each cell takes at most one update per scan; the
+  // cells they clear are flagged, so the query below skips them).
+  walked += walkRays(aside, sc, Blocks{}, RayWalkKind::kPerRay);
+  // By direction: a scan's rays are already in order up to a rotation (one descent, cyclically).
+  const std::size_t n = dir.size();
+  std::size_t descents = 0;
+  std::size_t first = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (dir[i].key > dir[(i + 1) % n].key) {
+      ++descents;
+      first = (i + 1) % n;
+    }
+  }
+  if (descents <= 1) {
+    std::rotate(dir.begin(), dir.begin() + static_cast<std::ptrdiff_t>(first), dir.end());
+  } else {
+    std::sort(dir.begin(), dir.end(),
+              [](const IntegrationScratch::DirectedRay& l,
+                 const IntegrationScratch::DirectedRay& r) { return l.key < r.key; });
+  }
+  if (n == 0) return walked;
+  const int ocx = static_cast<int>(ox >> RayWalk::kShift);
+  const int ocy = static_cast<int>(oy >> RayWalk::kShift);
+  constexpr double kEps = 1e-9;
+  const auto lowerKey = [&dir](double k) {
+    return std::lower_bound(dir.begin(), dir.end(), k,
+                            [](const IntegrationScratch::DirectedRay& r, double v) {
+                              return r.key < v;
+                            }) -
+           dir.begin();
+  };
+  // The rays in [lo, hi) of `dir` that clear (x, y): the first one decides.
+  const auto clearedBy = [&](std::ptrdiff_t lo, std::ptrdiff_t hi, int x, int y) {
+    for (std::ptrdiff_t k = lo; k < hi; ++k) {
+      if (rayClears(rays[dir[k].ray], x, y)) return true;
+    }
+    return false;
+  };
+  const std::ptrdiff_t all = static_cast<std::ptrdiff_t>(n);
+  const auto query = [&](int x, int y) {
+    if (std::abs(x - ocx) <= 1 && std::abs(y - ocy) <= 1) return clearedBy(0, all, x, y);
+    const double x0 = static_cast<double>((static_cast<std::int64_t>(x) << RayWalk::kShift) - ox);
+    const double y0 = static_cast<double>((static_cast<std::int64_t>(y) << RayWalk::kShift) - oy);
+    const double x1 = x0 + static_cast<double>(RayWalk::kOne);
+    const double y1 = y0 + static_cast<double>(RayWalk::kOne);
+    const double k00 = pseudoAngle(x0, y0);
+    const double k01 = pseudoAngle(x0, y1);
+    const double k10 = pseudoAngle(x1, y0);
+    const double k11 = pseudoAngle(x1, y1);
+    const double lo = std::min(std::min(k00, k01), std::min(k10, k11));
+    const double hi = std::max(std::max(k00, k01), std::max(k10, k11));
+    if (hi - lo > 2.0) {  // across the +x axis (pseudo-angle 0 = 4)
+      // The corners below the axis have keys near 4, those above near 0.
+      double lo_part = 0.0;  // largest key near 0
+      double hi_part = 4.0;  // smallest key near 4
+      for (const double k : {k00, k01, k10, k11}) {
+        if (k < 2.0) lo_part = std::max(lo_part, k);
+        if (k >= 2.0) hi_part = std::min(hi_part, k);
+      }
+      return clearedBy(0, lowerKey(lo_part + kEps), x, y) ||
+             clearedBy(lowerKey(hi_part - kEps), all, x, y);
+    }
+    return clearedBy(lowerKey(lo - kEps), lowerKey(hi + kEps), x, y);
+  };
+  const int w = box.max_x - box.min_x + 1;
+  for (int y = box.min_y; y <= box.max_y; ++y) {
+    std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + box.min_x;
+    for (int x0 = 0; x0 < w; x0 += kBlock) {
+      const int cw = std::min(kBlock, w - x0);
+      std::uint32_t mask = pendingMask(sc, row + x0, cw);
+      if (cw < kBlock) mask &= (1u << cw) - 1;
+      while (mask != 0) {
+        const int bit = __builtin_ctz(mask);
+        mask &= mask - 1;
+        const int x = box.min_x + x0 + bit;
+        if (query(x, y)) sc.clear(row + x0 + bit);
+      }
+    }
+  }
+  return walked;
+}
 }  // namespace
 
 IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>& beams,
@@ -905,6 +1046,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
   // entered where they do not (a sparse scan on a large map).
   std::vector<ClearingRay>& rays = s.rays;
   rays.clear();
+  s.ray_fixed.clear();
   std::size_t steps = 0;
   CellBounds box;
   for (const BeamUpdate& beam : beams) {
@@ -916,6 +1058,13 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     bool end_clipped = false;
     if (!clipSegmentToGrid(geometry, &x0, &y0, &x1, &y1, nullptr, &end_clipped)) continue;
     const RayWalk walk(geometry, x0, y0, x1, y1);
+    if (walk_kind == ClearingWalk::kReverseQuery) {
+      const double scale = static_cast<double>(RayWalk::kOne) / geometry.resolution();
+      const std::int64_t fx0 = RayWalk::fixedX(geometry, x0, scale);
+      const std::int64_t fy0 = RayWalk::fixedY(geometry, y0, scale);
+      s.ray_fixed.insert(s.ray_fixed.end(), {fx0, fy0, RayWalk::fixedX(geometry, x1, scale) - fx0,
+                                             RayWalk::fixedY(geometry, y1, scale) - fy0});
+    }
     // The walk stays inside the box of its end cells: bound it per beam, not per cell.
     box.expand(walk.cx, walk.cy);
     box.expand(walk.endX(), walk.endY());
@@ -943,6 +1092,11 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
       !use_blocks && !mark_sweep && !box.empty() &&
       (walk_kind == ClearingWalk::kFirstVisit ||
        (walk_kind == ClearingWalk::kAuto && saturated_share < kAutoMinSaturatedShare));
+  if (walk_kind == ClearingWalk::kReverseQuery) {
+    stats.cells_cleared = box.empty() ? 0 : clearByReverseQuery(sc, box, &s);
+    for (const std::uint32_t i : flagged) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
+    return stats;
+  }
   if (mark_sweep) {
     if (s.crossed.size() != geometry.cellCount()) s.crossed.assign(geometry.cellCount(), 0);
     std::size_t walked = 0;

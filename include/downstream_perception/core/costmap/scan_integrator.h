@@ -99,6 +99,12 @@ enum class ClearingWalk {
   /// the grid has hardly seen, where most visits update; kAuto takes it where less than a quarter
   /// of the box is saturated free and the mark-sweep does not pay.
   kFirstVisit,
+  /// Reverse query (issue 20 spike): the rays sharing one start point are sorted by direction;
+  /// every cell of their box a miss could change (not flagged, not saturated free) asks the rays
+  /// whose direction meets it whether their exact walk visits it before its end cell (an O(1)
+  /// integer test, the walk's own order rule). Other rays (another start, lattice corners) are
+  /// walked per ray first. Same grid and statistics as the per-ray walk; the flag order differs.
+  kReverseQuery,
 };
 
 /// ClearingWalk::kAuto's choice, from the rays' cells (steps summed over the rays), the cells of
@@ -141,6 +147,14 @@ struct IntegrationScratch {
   std::vector<Band> bands;
   std::vector<ClearingRay> rays_serial;  ///< rays through lattice corners that cross a band edge
   std::vector<double> row_work;          ///< the rays' cells per row, to place the band edges
+  /// Reverse query: per ray its fixed-point start and direction; the rays it queries, by direction.
+  std::vector<std::int64_t> ray_fixed;  ///< 4 per ray: fx0, fy0, dx, dy
+  struct DirectedRay {
+    double key;  ///< pseudo-angle of the direction, [0, 4)
+    std::uint32_t ray;
+  };
+  std::vector<DirectedRay> directed;
+  std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
 };
 
 /// The two-thread clearing walk starts at this many ray cells per scan: below it, waking the
