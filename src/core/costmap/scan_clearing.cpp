@@ -911,8 +911,9 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
       continue;
     }
     walked += static_cast<std::size_t>(ray.walk.stepsLeft()) + (ray.clear_end_cell ? 1 : 0);
-    dir.push_back({pseudoAngle(static_cast<double>(f[2]), static_cast<double>(f[3])),
-                   static_cast<std::uint32_t>(i)});
+    const double dx = static_cast<double>(f[2]);
+    const double dy = static_cast<double>(f[3]);
+    dir.push_back({pseudoAngle(dx, dy), dx * dx + dy * dy, static_cast<std::uint32_t>(i)});
   }
   // The other rays first, per ray (any order: each cell takes at most one update per scan; the
   // cells they clear are flagged, so the query below skips them).
@@ -938,58 +939,109 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
   const int ocx = static_cast<int>(ox >> RayWalk::kShift);
   const int ocy = static_cast<int>(oy >> RayWalk::kShift);
   constexpr double kEps = 1e-9;
-  const auto lowerKey = [&dir](double k) {
-    return std::lower_bound(dir.begin(), dir.end(), k,
+  const std::ptrdiff_t all = static_cast<std::ptrdiff_t>(n);
+  const auto lowerKey = [&dir](std::ptrdiff_t from, std::ptrdiff_t to, double k) {
+    return std::lower_bound(dir.begin() + from, dir.begin() + to, k,
                             [](const IntegrationScratch::DirectedRay& r, double v) {
                               return r.key < v;
                             }) -
            dir.begin();
   };
-  // The rays in [lo, hi) of `dir` that clear (x, y): the first one decides.
-  const auto clearedBy = [&](std::ptrdiff_t lo, std::ptrdiff_t hi, int x, int y) {
-    for (std::ptrdiff_t k = lo; k < hi; ++k) {
-      if (rayClears(rays[dir[k].ray], x, y)) return true;
+  // The rays of dir[from, to) whose direction can meet the cells [x0, x1) x [y0, y1) (lattice
+  // units), as up to two index ranges r[0..3]; all of dir[from, to) when the rectangle holds or
+  // touches the start cell's neighbourhood. A superset: the exact test decides.
+  const auto candidates = [&](int cx0, int cy0, int cx1, int cy1, std::ptrdiff_t from,
+                              std::ptrdiff_t to, std::ptrdiff_t* r) {
+    r[2] = r[3] = 0;
+    if (ocx >= cx0 - 1 && ocx <= cx1 && ocy >= cy0 - 1 && ocy <= cy1) {
+      r[0] = from;
+      r[1] = to;
+      return;
+    }
+    const double x0 = static_cast<double>((static_cast<std::int64_t>(cx0) << RayWalk::kShift) - ox);
+    const double y0 = static_cast<double>((static_cast<std::int64_t>(cy0) << RayWalk::kShift) - oy);
+    const double x1 = static_cast<double>((static_cast<std::int64_t>(cx1) << RayWalk::kShift) - ox);
+    const double y1 = static_cast<double>((static_cast<std::int64_t>(cy1) << RayWalk::kShift) - oy);
+    const double k[4] = {pseudoAngle(x0, y0), pseudoAngle(x0, y1), pseudoAngle(x1, y0),
+                         pseudoAngle(x1, y1)};
+    const double lo = std::min(std::min(k[0], k[1]), std::min(k[2], k[3]));
+    const double hi = std::max(std::max(k[0], k[1]), std::max(k[2], k[3]));
+    if (hi - lo > 2.0) {  // across the +x axis (pseudo-angle 0 = 4)
+      double lo_part = 0.0;  // largest key near 0
+      double hi_part = 4.0;  // smallest key near 4
+      for (const double kk : k) {
+        if (kk < 2.0) lo_part = std::max(lo_part, kk);
+        if (kk >= 2.0) hi_part = std::min(hi_part, kk);
+      }
+      r[0] = from;
+      r[1] = lowerKey(from, to, lo_part + kEps);
+      r[2] = lowerKey(from, to, hi_part - kEps);
+      r[3] = to;
+      return;
+    }
+    r[0] = lowerKey(from, to, lo - kEps);
+    r[1] = lowerKey(r[0], to, hi + kEps);
+  };
+  // The squared distance (fixed point, as a double) from the start to the rectangle.
+  const auto distance2 = [&](int cx0, int cy0, int cx1, int cy1) {
+    const std::int64_t lx = static_cast<std::int64_t>(cx0) << RayWalk::kShift;
+    const std::int64_t hx = static_cast<std::int64_t>(cx1) << RayWalk::kShift;
+    const std::int64_t ly = static_cast<std::int64_t>(cy0) << RayWalk::kShift;
+    const std::int64_t hy = static_cast<std::int64_t>(cy1) << RayWalk::kShift;
+    const double dx = static_cast<double>(ox < lx ? lx - ox : (ox > hx ? ox - hx : 0));
+    const double dy = static_cast<double>(oy < ly ? ly - oy : (oy > hy ? oy - hy : 0));
+    return dx * dx + dy * dy;
+  };
+  const auto maxLength2 = [&](const std::ptrdiff_t* r) {
+    double m = 0.0;
+    for (int part = 0; part < 2; ++part) {
+      for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i) m = std::max(m, dir[i].length2);
+    }
+    return m;
+  };
+  const auto clearedBy = [&](const std::ptrdiff_t* r, int x, int y) {
+    for (int part = 0; part < 2; ++part) {
+      for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i) {
+        if (rayClears(rays[dir[i].ray], x, y)) return true;
+      }
     }
     return false;
   };
-  const std::ptrdiff_t all = static_cast<std::ptrdiff_t>(n);
-  const auto query = [&](int x, int y) {
-    if (std::abs(x - ocx) <= 1 && std::abs(y - ocy) <= 1) return clearedBy(0, all, x, y);
-    const double x0 = static_cast<double>((static_cast<std::int64_t>(x) << RayWalk::kShift) - ox);
-    const double y0 = static_cast<double>((static_cast<std::int64_t>(y) << RayWalk::kShift) - oy);
-    const double x1 = x0 + static_cast<double>(RayWalk::kOne);
-    const double y1 = y0 + static_cast<double>(RayWalk::kOne);
-    const double k00 = pseudoAngle(x0, y0);
-    const double k01 = pseudoAngle(x0, y1);
-    const double k10 = pseudoAngle(x1, y0);
-    const double k11 = pseudoAngle(x1, y1);
-    const double lo = std::min(std::min(k00, k01), std::min(k10, k11));
-    const double hi = std::max(std::max(k00, k01), std::max(k10, k11));
-    if (hi - lo > 2.0) {  // across the +x axis (pseudo-angle 0 = 4)
-      // The corners below the axis have keys near 4, those above near 0.
-      double lo_part = 0.0;  // largest key near 0
-      double hi_part = 4.0;  // smallest key near 4
-      for (const double k : {k00, k01, k10, k11}) {
-        if (k < 2.0) lo_part = std::max(lo_part, k);
-        if (k >= 2.0) hi_part = std::min(hi_part, k);
+  std::uint32_t masks[kBlock];
+  for (int by = box.min_y >> kBlockShift; by <= box.max_y >> kBlockShift; ++by) {
+    const int y0 = std::max(box.min_y, by << kBlockShift);
+    const int y1 = std::min(box.max_y + 1, (by + 1) << kBlockShift);
+    for (int bx = box.min_x >> kBlockShift; bx <= box.max_x >> kBlockShift; ++bx) {
+      const int x0 = std::max(box.min_x, bx << kBlockShift);
+      const int x1 = std::min(box.max_x + 1, (bx + 1) << kBlockShift);
+      std::uint32_t any = 0;
+      for (int y = y0; y < y1; ++y) {
+        masks[y - y0] = pendingMask(sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + x0,
+                                    x1 - x0);
+        if (x1 - x0 < kBlock) masks[y - y0] &= (1u << (x1 - x0)) - 1;
+        any |= masks[y - y0];
       }
-      return clearedBy(0, lowerKey(lo_part + kEps), x, y) ||
-             clearedBy(lowerKey(hi_part - kEps), all, x, y);
-    }
-    return clearedBy(lowerKey(lo - kEps), lowerKey(hi + kEps), x, y);
-  };
-  const int w = box.max_x - box.min_x + 1;
-  for (int y = box.min_y; y <= box.max_y; ++y) {
-    std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + box.min_x;
-    for (int x0 = 0; x0 < w; x0 += kBlock) {
-      const int cw = std::min(kBlock, w - x0);
-      std::uint32_t mask = pendingMask(sc, row + x0, cw);
-      if (cw < kBlock) mask &= (1u << cw) - 1;
-      while (mask != 0) {
-        const int bit = __builtin_ctz(mask);
-        mask &= mask - 1;
-        const int x = box.min_x + x0 + bit;
-        if (query(x, y)) sc.clear(row + x0 + bit);
+      if (any == 0) continue;
+      // The block's candidate rays; none reaching as far as the block: nothing to clear here.
+      std::ptrdiff_t block_r[4];
+      candidates(x0, y0, x1, y1, 0, all, block_r);
+      const double reach = maxLength2(block_r);
+      if (reach * (1.0 + kEps) < distance2(x0, y0, x1, y1)) continue;
+      for (int y = y0; y < y1; ++y) {
+        std::uint32_t mask = masks[y - y0];
+        std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x;
+        while (mask != 0) {
+          const int x = x0 + __builtin_ctz(mask);
+          mask &= mask - 1;
+          std::ptrdiff_t r[4];
+          if (block_r[2] == block_r[3]) {
+            candidates(x, y, x + 1, y + 1, block_r[0], block_r[1], r);
+          } else {
+            candidates(x, y, x + 1, y + 1, 0, all, r);
+          }
+          if (maxLength2(r) * (1.0 + kEps) < distance2(x, y, x + 1, y + 1)) continue;
+          if (clearedBy(r, x, y)) sc.clear(row + x);
+        }
       }
     }
   }

@@ -150,7 +150,8 @@ struct IntegrationScratch {
   /// Reverse query: per ray its fixed-point start and direction; the rays it queries, by direction.
   std::vector<std::int64_t> ray_fixed;  ///< 4 per ray: fx0, fy0, dx, dy
   struct DirectedRay {
-    double key;  ///< pseudo-angle of the direction, [0, 4)
+    double key;      ///< pseudo-angle of the direction, [0, 4)
+    double length2;  ///< squared length (fixed point)
     std::uint32_t ray;
   };
   std::vector<DirectedRay> directed;
