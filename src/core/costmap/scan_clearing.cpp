@@ -940,12 +940,26 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
   const int ocy = static_cast<int>(oy >> RayWalk::kShift);
   constexpr double kEps = 1e-9;
   const std::ptrdiff_t all = static_cast<std::ptrdiff_t>(n);
-  const auto lowerKey = [&dir](std::ptrdiff_t from, std::ptrdiff_t to, double k) {
-    return std::lower_bound(dir.begin() + from, dir.begin() + to, k,
-                            [](const IntegrationScratch::DirectedRay& r, double v) {
-                              return r.key < v;
-                            }) -
-           dir.begin();
+  // lower_bound over the keys in O(1): a table of the first ray at or after each of kBuckets
+  // equal steps of the key, then a short scan (a scan's rays are about as many as the buckets).
+  static constexpr int kBuckets = 8192;
+  static constexpr double kBucketScale = kBuckets / 4.0;
+  std::vector<std::uint32_t>& bucket = s->key_buckets;
+  bucket.resize(kBuckets + 1);
+  {
+    std::size_t i = 0;
+    for (int b = 0; b <= kBuckets; ++b) {
+      const double start = b / kBucketScale;
+      while (i < n && dir[i].key < start) ++i;
+      bucket[b] = static_cast<std::uint32_t>(i);
+    }
+  }
+  const auto lowerKey = [&dir, &bucket, n](std::ptrdiff_t from, std::ptrdiff_t to, double k) {
+    const int b = std::max(0, std::min(kBuckets, static_cast<int>(k * kBucketScale)));
+    std::ptrdiff_t i = std::max<std::ptrdiff_t>(from, bucket[b]);
+    (void)n;
+    while (i < to && dir[i].key < k) ++i;
+    return std::min(i, to);
   };
   // The rays of dir[from, to) whose direction can meet the cells [x0, x1) x [y0, y1) (lattice
   // units), as up to two index ranges r[0..3]; all of dir[from, to) when the rectangle holds or

@@ -155,6 +155,7 @@ struct IntegrationScratch {
     std::uint32_t ray;
   };
   std::vector<DirectedRay> directed;
+  std::vector<std::uint32_t> key_buckets;  ///< first ray of each key bucket
   std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
 };
 
