@@ -1013,15 +1013,8 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
     }
     return m;
   };
-  const auto clearedBy = [&](const std::ptrdiff_t* r, int x, int y) {
-    for (int part = 0; part < 2; ++part) {
-      for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i) {
-        if (rayClears(rays[dir[i].ray], x, y)) return true;
-      }
-    }
-    return false;
-  };
   std::uint32_t masks[kBlock];
+  std::vector<std::uint32_t>& near = s->near_rays;
   for (int by = box.min_y >> kBlockShift; by <= box.max_y >> kBlockShift; ++by) {
     const int y0 = std::max(box.min_y, by << kBlockShift);
     const int y1 = std::min(box.max_y + 1, (by + 1) << kBlockShift);
@@ -1045,16 +1038,41 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
         std::uint32_t mask = masks[y - y0];
         std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x;
         while (mask != 0) {
-          const int x = x0 + __builtin_ctz(mask);
-          mask &= mask - 1;
+          // A run of changeable cells [xs, xe) in this row: its candidate rays whose box of cells
+          // (start to end cell) meets the run; none, nothing in the run can be cleared.
+          const int s0 = __builtin_ctz(mask);
+          const std::uint32_t rest = ~(mask >> s0);
+          const int len = rest == 0 ? 32 - s0 : __builtin_ctz(rest);
+          mask = len + s0 >= 32 ? 0 : mask & ~(((1u << len) - 1) << s0);
+          const int xs = x0 + s0;
+          const int xe = xs + len;
           std::ptrdiff_t r[4];
           if (block_r[2] == block_r[3]) {
-            candidates(x, y, x + 1, y + 1, block_r[0], block_r[1], r);
+            candidates(xs, y, xe, y + 1, block_r[0], block_r[1], r);
           } else {
-            candidates(x, y, x + 1, y + 1, 0, all, r);
+            candidates(xs, y, xe, y + 1, 0, all, r);
           }
-          if (maxLength2(r) * (1.0 + kEps) < distance2(x, y, x + 1, y + 1)) continue;
-          if (clearedBy(r, x, y)) sc.clear(row + x);
+          near.clear();
+          for (int part = 0; part < 2; ++part) {
+            for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i) {
+              const ClearingRay& ray = rays[dir[i].ray];
+              const RayWalk& w = ray.walk;
+              const int ex = w.endX();
+              const int ey = w.endY();
+              if (y < std::min(w.cy, ey) || y > std::max(w.cy, ey)) continue;
+              if (xe - 1 < std::min(w.cx, ex) || xs > std::max(w.cx, ex)) continue;
+              near.push_back(dir[i].ray);
+            }
+          }
+          if (near.empty()) continue;
+          for (int x = xs; x < xe; ++x) {
+            for (const std::uint32_t k : near) {
+              if (rayClears(rays[k], x, y)) {
+                sc.clear(row + x);
+                break;
+              }
+            }
+          }
         }
       }
     }

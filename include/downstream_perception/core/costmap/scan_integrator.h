@@ -156,6 +156,7 @@ struct IntegrationScratch {
   };
   std::vector<DirectedRay> directed;
   std::vector<std::uint32_t> key_buckets;  ///< first ray of each key bucket
+  std::vector<std::uint32_t> near_rays;    ///< the rays that may reach a run of cells
   std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
 };
 
