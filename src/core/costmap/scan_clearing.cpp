@@ -894,25 +894,24 @@ inline bool rayClears(const ClearingRay& ray, int x, int y) {
 // rays' cells, counted as the per-ray walk counts them). rays_fixed: per ray fx0, fy0, dx, dy.
 std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, IntegrationScratch* s) {
   const std::vector<ClearingRay>& rays = s->rays;
-  const std::int64_t* fixed = s->ray_fixed.data();
   std::vector<IntegrationScratch::DirectedRay>& dir = s->directed;
   std::vector<ClearingRay>& aside = s->rays_aside;
   dir.clear();
   aside.clear();
   std::size_t walked = 0;
   if (rays.empty()) return 0;
-  const std::int64_t ox = fixed[0];
-  const std::int64_t oy = fixed[1];
+  const std::int64_t ox = s->ray_origin[0];
+  const std::int64_t oy = s->ray_origin[1];
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const ClearingRay& ray = rays[i];
-    const std::int64_t* f = fixed + 4 * i;
-    if (ray.walk.corners || f[0] != ox || f[1] != oy || ray.walk.stepsLeft() == 0) {
+    if (ray.walk.corners || !s->same_origin[i] || ray.walk.stepsLeft() == 0) {
       aside.push_back(ray);
       continue;
     }
     walked += static_cast<std::size_t>(ray.walk.stepsLeft()) + (ray.clear_end_cell ? 1 : 0);
-    const double dx = static_cast<double>(f[2]);
-    const double dy = static_cast<double>(f[3]);
+    // The direction in fixed point: err_step_x = kOne |dy|, err_step_y = kOne |dx| (exact).
+    const double dx = static_cast<double>(ray.walk.sx * (ray.walk.err_step_y >> RayWalk::kShift));
+    const double dy = static_cast<double>(ray.walk.sy * (ray.walk.err_step_x >> RayWalk::kShift));
     dir.push_back({pseudoAngle(dx, dy), dx * dx + dy * dy, static_cast<std::uint32_t>(i)});
   }
   // The other rays first, per ray (any order: each cell takes at most one update per scan; the
@@ -1130,7 +1129,10 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
   // entered where they do not (a sparse scan on a large map).
   std::vector<ClearingRay>& rays = s.rays;
   rays.clear();
-  s.ray_fixed.clear();
+  s.same_origin.clear();
+  bool origin_set = false;
+  double origin_x = 0.0;
+  double origin_y = 0.0;
   std::size_t steps = 0;
   CellBounds box;
   for (const BeamUpdate& beam : beams) {
@@ -1140,14 +1142,24 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     double x1 = beam.end_x;
     double y1 = beam.end_y;
     bool end_clipped = false;
-    if (!clipSegmentToGrid(geometry, &x0, &y0, &x1, &y1, nullptr, &end_clipped)) continue;
+    bool start_clipped = false;
+    if (!clipSegmentToGrid(geometry, &x0, &y0, &x1, &y1, &start_clipped, &end_clipped)) continue;
     const RayWalk walk(geometry, x0, y0, x1, y1);
     if (walk_kind == ClearingWalk::kReverseQuery) {
-      const double scale = static_cast<double>(RayWalk::kOne) / geometry.resolution();
-      const std::int64_t fx0 = RayWalk::fixedX(geometry, x0, scale);
-      const std::int64_t fy0 = RayWalk::fixedY(geometry, y0, scale);
-      s.ray_fixed.insert(s.ray_fixed.end(), {fx0, fy0, RayWalk::fixedX(geometry, x1, scale) - fx0,
-                                             RayWalk::fixedY(geometry, y1, scale) - fy0});
+      // Rays from the same (unclipped) start point share its fixed-point start exactly.
+      bool same = false;
+      if (!start_clipped) {
+        if (!origin_set) {
+          origin_set = true;
+          origin_x = x0;
+          origin_y = y0;
+          const double scale = static_cast<double>(RayWalk::kOne) / geometry.resolution();
+          s.ray_origin[0] = RayWalk::fixedX(geometry, x0, scale);
+          s.ray_origin[1] = RayWalk::fixedY(geometry, y0, scale);
+        }
+        same = x0 == origin_x && y0 == origin_y;
+      }
+      s.same_origin.push_back(same ? 1 : 0);
     }
     // The walk stays inside the box of its end cells: bound it per beam, not per cell.
     box.expand(walk.cx, walk.cy);

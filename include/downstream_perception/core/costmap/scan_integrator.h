@@ -147,8 +147,10 @@ struct IntegrationScratch {
   std::vector<Band> bands;
   std::vector<ClearingRay> rays_serial;  ///< rays through lattice corners that cross a band edge
   std::vector<double> row_work;          ///< the rays' cells per row, to place the band edges
-  /// Reverse query: per ray its fixed-point start and direction; the rays it queries, by direction.
-  std::vector<std::int64_t> ray_fixed;  ///< 4 per ray: fx0, fy0, dx, dy
+  /// Reverse query: per ray whether it starts at the scan's common start point (ray_origin, fixed
+  /// point); the rays it queries, by direction.
+  std::vector<std::uint8_t> same_origin;
+  std::int64_t ray_origin[2] = {0, 0};
   struct DirectedRay {
     double key;      ///< pseudo-angle of the direction, [0, 4)
     double length2;  ///< squared length (fixed point)
