@@ -890,6 +890,29 @@ inline bool rayClears(const ClearingRay& ray, int x, int y) {
   return true;
 }
 
+// Whether the 32-cell rows [row, row + rows * size_x) are all saturated free (unflagged, at the
+// lower clamp): one compare per eight cells.
+inline bool allSaturatedFree(const ScanCells& sc, const std::int16_t* row, int rows) {
+#if defined(__SSE2__)
+  const __m128i sat = _mm_set1_epi16(sc.saturated_free_raw);
+  __m128i all = _mm_set1_epi16(-1);
+  for (int y = 0; y < rows; ++y, row += sc.size_x) {
+    for (int k = 0; k < kBlock; k += 8) {
+      all = _mm_and_si128(
+          all, _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row + k)), sat));
+    }
+  }
+  return _mm_movemask_epi8(all) == 0xFFFF;
+#else
+  for (int y = 0; y < rows; ++y, row += sc.size_x) {
+    for (int k = 0; k < kBlock; ++k) {
+      if (row[k] != sc.saturated_free_raw) return false;
+    }
+  }
+  return true;
+#endif
+}
+
 // Pass 2 by reverse query (see ClearingWalk::kReverseQuery); returns the cells walked (the
 // rays' cells, counted as the per-ray walk counts them). rays_fixed: per ray fx0, fy0, dx, dy.
 std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, IntegrationScratch* s) {
@@ -1020,12 +1043,30 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
     for (int bx = box.min_x >> kBlockShift; bx <= box.max_x >> kBlockShift; ++bx) {
       const int x0 = std::max(box.min_x, bx << kBlockShift);
       const int x1 = std::min(box.max_x + 1, (bx + 1) << kBlockShift);
+      // The block's changeable cells in the box (row masks, bit 0 at x0). Whole 32-cell rows of
+      // the grid where the block fits in it: first a test that every cell is saturated free (most
+      // blocks in steady state), then the masks.
       std::uint32_t any = 0;
-      for (int y = y0; y < y1; ++y) {
-        masks[y - y0] = pendingMask(sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + x0,
-                                    x1 - x0);
-        if (x1 - x0 < kBlock) masks[y - y0] &= (1u << (x1 - x0)) - 1;
-        any |= masks[y - y0];
+      const int xa = bx << kBlockShift;
+      const std::uint32_t in_box = bitRange(x0 - xa, x1 - 1 - xa);
+      if (xa + kBlock <= sc.size_x) {
+        if (allSaturatedFree(sc, sc.cells + static_cast<std::ptrdiff_t>(y0) * sc.size_x + xa,
+                             y1 - y0)) {
+          continue;
+        }
+        for (int y = y0; y < y1; ++y) {
+          masks[y - y0] =
+              (pendingMask(sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + xa, kBlock) &
+               in_box) >>
+              (x0 - xa);
+          any |= masks[y - y0];
+        }
+      } else {
+        for (int y = y0; y < y1; ++y) {
+          masks[y - y0] = pendingMask(
+              sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + x0, x1 - x0);
+          any |= masks[y - y0];
+        }
       }
       if (any == 0) continue;
       // The block's candidate rays; none reaching as far as the block: nothing to clear here.
