@@ -854,7 +854,6 @@ std::size_t walkRaysInBands(const ScanCells& sc, const Blocks& blocks, RayWalkKi
   return walked;
 }
 
-
 // --- Reverse query (ClearingWalk::kReverseQuery, issue 20 spike) ---
 
 // A pseudo-angle of the direction (dx, dy) in [0, 4): monotone in atan2 over a turn starting at
@@ -1002,7 +1001,7 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
                          pseudoAngle(x1, y1)};
     const double lo = std::min(std::min(k[0], k[1]), std::min(k[2], k[3]));
     const double hi = std::max(std::max(k[0], k[1]), std::max(k[2], k[3]));
-    if (hi - lo > 2.0) {  // across the +x axis (pseudo-angle 0 = 4)
+    if (hi - lo > 2.0) {     // across the +x axis (pseudo-angle 0 = 4)
       double lo_part = 0.0;  // largest key near 0
       double hi_part = 4.0;  // smallest key near 4
       for (const double kk : k) {
@@ -1031,7 +1030,8 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
   const auto maxLength2 = [&](const std::ptrdiff_t* r) {
     double m = 0.0;
     for (int part = 0; part < 2; ++part) {
-      for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i) m = std::max(m, dir[i].length2);
+      for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i)
+        m = std::max(m, dir[i].length2);
     }
     return m;
   };
@@ -1063,8 +1063,8 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
         }
       } else {
         for (int y = y0; y < y1; ++y) {
-          masks[y - y0] = pendingMask(
-              sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + x0, x1 - x0);
+          masks[y - y0] =
+              pendingMask(sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + x0, x1 - x0);
           any |= masks[y - y0];
         }
       }

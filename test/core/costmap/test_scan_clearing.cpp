@@ -119,6 +119,8 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
   LogOddsGrid threaded_first_visit(g, model);
   LogOddsGrid swept(g, model);
   LogOddsGrid first_visit(g, model);
+  LogOddsGrid reverse(g, model);
+  IntegrationScratch reverse_scratch;
   std::vector<int> oracle(g.cellCount(), 0);
   IntegrationScratch scratch;  // reused across scans, as the integrator does
   IntegrationScratch auto_scratch;
@@ -160,6 +162,8 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
         integrateBeams(swept, scan, &sweep_scratch, ClearingWalk::kMarkSweep);
     const IntegrationStats h_first =
         integrateBeams(first_visit, scan, nullptr, ClearingWalk::kFirstVisit);
+    const IntegrationStats i_reverse =
+        integrateBeams(reverse, scan, &reverse_scratch, ClearingWalk::kReverseQuery);
     const std::vector<int> before = oracle;
     oracleIntegrate(g, per_ray, &oracle, scan);
     // The oracle's statistics: cells whose state class (free / unknown / occupied) changed.
@@ -185,6 +189,7 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     expectSameStats(f, b);
     expectSameStats(g_swept, b);
     expectSameStats(h_first, b);
+    expectSameStats(i_reverse, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
@@ -196,6 +201,7 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
       ASSERT_EQ(swept.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(first_visit.rawCells()[i], per_ray.rawCells()[i])
           << "seed " << seed << " scan " << s;
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(blocks.units(i), oracle[i]) << "seed " << seed << " scan " << s << " cell " << i;
     }
   }
@@ -268,13 +274,20 @@ TEST(ScanClearing, AxisAlignedAndSingleCellRays) {
     d.clear_end_cell = k % 2 == 0;
     scan.push_back(d);
   }
+  LogOddsGrid reverse(g);
   IntegrationScratch scratch;
+  IntegrationScratch reverse_scratch;
   for (int round = 0; round < 12; ++round) {
     const IntegrationStats a = integrateBeams(blocks, scan, &scratch, ClearingWalk::kBlockSkip);
     const IntegrationStats b = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats c =
+        integrateBeams(reverse, scan, &reverse_scratch, ClearingWalk::kReverseQuery);
     expectSameStats(a, b);
-    for (std::size_t i = 0; i < g.cellCount(); ++i)
+    expectSameStats(c, b);
+    for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]);
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]);
+    }
   }
   // 12 misses at -0.405 each saturate nothing (clamp -8 needs 20): the swept column is free.
   EXPECT_EQ(blocks.state(g.index(0, 30)), CellState::kFree);
@@ -361,8 +374,10 @@ TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
   LogOddsGrid per_ray(g);
   LogOddsGrid blocks(g);
   LogOddsGrid threaded(g);
+  LogOddsGrid reverse(g);
   IntegrationScratch block_scratch;
   IntegrationScratch threaded_scratch;
+  IntegrationScratch reverse_scratch;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> spot(-1.5, 1.5);
   std::normal_distribution<double> noise(0.0, 0.01);
@@ -394,12 +409,16 @@ TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
     const IntegrationStats c =
         integrateBeams(threaded, scan, &threaded_scratch, ClearingWalk::kBlockSkip, 2, 0);
     expectSameStats(b, a);
+    const IntegrationStats d =
+        integrateBeams(reverse, scan, &reverse_scratch, ClearingWalk::kReverseQuery);
     expectSameStats(c, a);
+    expectSameStats(d, a);
     ASSERT_FALSE(threaded_scratch.bands.empty());
     expectBandsStayInTheirRows(threaded_scratch, g.sizeX());
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
       ASSERT_EQ(threaded.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
     }
   }
   // The outside stayed unseen and the walls occupied.
