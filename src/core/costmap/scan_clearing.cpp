@@ -332,6 +332,10 @@ constexpr std::size_t kAutoBlockWalkNumerator = 1;
 constexpr std::size_t kAutoBlockWalkDenominator = 1;
 constexpr double kAutoMinSaturatedShare = 0.25;
 constexpr int kSaturationSamples = 16;  // per axis
+// kAuto takes the reverse query over the block walk while the box holds at most one cell a miss
+// could change per this many ray cells (3600-beam room in steady state: ~25 k such cells, ~1.8 M
+// ray cells; the query costs ~7 ns per such cell, the block walk ~0.3 ns per ray cell).
+constexpr std::size_t kAutoRayCellsPerChangeableCell = 32;
 
 // Share of the box's cells (a regular sample) that sit at the lower clamp.
 double saturatedFreeShare(const ScanCells& sc, const CellBounds& box) {
@@ -912,16 +916,19 @@ inline bool allSaturatedFree(const ScanCells& sc, const std::int16_t* row, int r
 #endif
 }
 
-// Pass 2 by reverse query (see ClearingWalk::kReverseQuery); returns the cells walked (the
-// rays' cells, counted as the per-ray walk counts them). rays_fixed: per ray fx0, fy0, dx, dy.
-std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, IntegrationScratch* s) {
+// Pass 2 by reverse query (see ClearingWalk::kReverseQuery): adds the cells walked (the rays'
+// cells, counted as the per-ray walk counts them) to *walked_out. Returns false, having changed
+// nothing, when the box holds more than max_changeable cells a miss could change (a scan over
+// space the grid has not saturated yet: each costs a query, the forward walks are cheaper).
+bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, std::size_t max_changeable,
+                         IntegrationScratch* s, std::size_t* walked_out) {
   const std::vector<ClearingRay>& rays = s->rays;
   std::vector<IntegrationScratch::DirectedRay>& dir = s->directed;
   std::vector<ClearingRay>& aside = s->rays_aside;
   dir.clear();
   aside.clear();
   std::size_t walked = 0;
-  if (rays.empty()) return 0;
+  if (rays.empty()) return true;
   const std::int64_t ox = s->ray_origin[0];
   const std::int64_t oy = s->ray_origin[1];
   for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -936,8 +943,50 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
     const double dy = static_cast<double>(ray.walk.sy * (ray.walk.err_step_x >> RayWalk::kShift));
     dir.push_back({pseudoAngle(dx, dy), dx * dx + dy * dy, static_cast<std::uint32_t>(i)});
   }
+  // The blocks of the box with cells a miss could change, and their row masks (bit 0 at the
+  // block's first column in the box); the count decides whether the query pays.
+  std::vector<IntegrationScratch::QueryBlock>& qblocks = s->query_blocks;
+  std::vector<std::uint32_t>& qmasks = s->query_masks;
+  qblocks.clear();
+  qmasks.clear();
+  std::size_t changeable = 0;
+  for (int by = box.min_y >> kBlockShift; by <= box.max_y >> kBlockShift; ++by) {
+    const int y0 = std::max(box.min_y, by << kBlockShift);
+    const int y1 = std::min(box.max_y + 1, (by + 1) << kBlockShift);
+    for (int bx = box.min_x >> kBlockShift; bx <= box.max_x >> kBlockShift; ++bx) {
+      const int x0 = std::max(box.min_x, bx << kBlockShift);
+      const int x1 = std::min(box.max_x + 1, (bx + 1) << kBlockShift);
+      // Whole 32-cell rows of the grid where the block fits in it: first a test that every cell
+      // is saturated free (most blocks in steady state), then the masks.
+      const int xa = bx << kBlockShift;
+      const bool whole_rows = xa + kBlock <= sc.size_x;
+      if (whole_rows &&
+          allSaturatedFree(sc, sc.cells + static_cast<std::ptrdiff_t>(y0) * sc.size_x + xa,
+                           y1 - y0)) {
+        continue;
+      }
+      const std::uint32_t in_box = bitRange(x0 - xa, x1 - 1 - xa);
+      const std::size_t offset = qmasks.size();
+      std::uint32_t any = 0;
+      for (int y = y0; y < y1; ++y) {
+        const std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x;
+        const std::uint32_t m = whole_rows
+                                    ? (pendingMask(sc, row + xa, kBlock) & in_box) >> (x0 - xa)
+                                    : pendingMask(sc, row + x0, x1 - x0);
+        qmasks.push_back(m);
+        any |= m;
+        changeable += static_cast<std::size_t>(__builtin_popcount(m));
+      }
+      if (any == 0) {
+        qmasks.resize(offset);
+        continue;
+      }
+      qblocks.push_back({x0, y0, x1, y1, static_cast<std::uint32_t>(offset)});
+    }
+    if (changeable > max_changeable) return false;
+  }
   // The other rays first, per ray (any order: each cell takes at most one update per scan; the
-  // cells they clear are flagged, so the query below skips them).
+  // cells they clear are flagged, and the query below checks each cell's flag again).
   walked += walkRays(aside, sc, Blocks{}, RayWalkKind::kPerRay);
   // By direction: a scan's rays are already in order up to a rotation (one descent, cyclically).
   const std::size_t n = dir.size();
@@ -956,7 +1005,10 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
               [](const IntegrationScratch::DirectedRay& l,
                  const IntegrationScratch::DirectedRay& r) { return l.key < r.key; });
   }
-  if (n == 0) return walked;
+  if (n == 0) {
+    *walked_out += walked;
+    return true;
+  }
   const int ocx = static_cast<int>(ox >> RayWalk::kShift);
   const int ocy = static_cast<int>(oy >> RayWalk::kShift);
   constexpr double kEps = 1e-9;
@@ -1035,40 +1087,14 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
     }
     return m;
   };
-  std::uint32_t masks[kBlock];
   std::vector<std::uint32_t>& near = s->near_rays;
-  for (int by = box.min_y >> kBlockShift; by <= box.max_y >> kBlockShift; ++by) {
-    const int y0 = std::max(box.min_y, by << kBlockShift);
-    const int y1 = std::min(box.max_y + 1, (by + 1) << kBlockShift);
-    for (int bx = box.min_x >> kBlockShift; bx <= box.max_x >> kBlockShift; ++bx) {
-      const int x0 = std::max(box.min_x, bx << kBlockShift);
-      const int x1 = std::min(box.max_x + 1, (bx + 1) << kBlockShift);
-      // The block's changeable cells in the box (row masks, bit 0 at x0). Whole 32-cell rows of
-      // the grid where the block fits in it: first a test that every cell is saturated free (most
-      // blocks in steady state), then the masks.
-      std::uint32_t any = 0;
-      const int xa = bx << kBlockShift;
-      const std::uint32_t in_box = bitRange(x0 - xa, x1 - 1 - xa);
-      if (xa + kBlock <= sc.size_x) {
-        if (allSaturatedFree(sc, sc.cells + static_cast<std::ptrdiff_t>(y0) * sc.size_x + xa,
-                             y1 - y0)) {
-          continue;
-        }
-        for (int y = y0; y < y1; ++y) {
-          masks[y - y0] =
-              (pendingMask(sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + xa, kBlock) &
-               in_box) >>
-              (x0 - xa);
-          any |= masks[y - y0];
-        }
-      } else {
-        for (int y = y0; y < y1; ++y) {
-          masks[y - y0] =
-              pendingMask(sc, sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x + x0, x1 - x0);
-          any |= masks[y - y0];
-        }
-      }
-      if (any == 0) continue;
+  for (const IntegrationScratch::QueryBlock& qb : qblocks) {
+    {
+      const int x0 = qb.x0;
+      const int y0 = qb.y0;
+      const int x1 = qb.x1;
+      const int y1 = qb.y1;
+      const std::uint32_t* masks = qmasks.data() + qb.masks;
       // The block's candidate rays; none reaching as far as the block: nothing to clear here.
       std::ptrdiff_t block_r[4];
       candidates(x0, y0, x1, y1, 0, all, block_r);
@@ -1108,7 +1134,7 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
           for (int x = xs; x < xe; ++x) {
             for (const std::uint32_t k : near) {
               if (rayClears(rays[k], x, y)) {
-                sc.clear(row + x);
+                if (!sc.skipsMiss(row[x])) sc.clear(row + x);  // unless an other ray's
                 break;
               }
             }
@@ -1117,7 +1143,8 @@ std::size_t clearByReverseQuery(const ScanCells& sc, const CellBounds& box, Inte
       }
     }
   }
-  return walked;
+  *walked_out += walked;
+  return true;
 }
 }  // namespace
 
@@ -1186,7 +1213,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     bool start_clipped = false;
     if (!clipSegmentToGrid(geometry, &x0, &y0, &x1, &y1, &start_clipped, &end_clipped)) continue;
     const RayWalk walk(geometry, x0, y0, x1, y1);
-    if (walk_kind == ClearingWalk::kReverseQuery) {
+    if (walk_kind == ClearingWalk::kReverseQuery || walk_kind == ClearingWalk::kAuto) {
       // Rays from the same (unclipped) start point share its fixed-point start exactly.
       bool same = false;
       if (!start_clipped) {
@@ -1229,10 +1256,19 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
       !use_blocks && !mark_sweep && !box.empty() &&
       (walk_kind == ClearingWalk::kFirstVisit ||
        (walk_kind == ClearingWalk::kAuto && saturated_share < kAutoMinSaturatedShare));
-  if (walk_kind == ClearingWalk::kReverseQuery) {
-    stats.cells_cleared = box.empty() ? 0 : clearByReverseQuery(sc, box, &s);
-    for (const std::uint32_t i : flagged) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
-    return stats;
+  // The reverse query where the block walk would run (dense rays over seen space), unless the box
+  // holds too many cells a miss could change (then the block walk runs as before).
+  if (!box.empty() && (walk_kind == ClearingWalk::kReverseQuery ||
+                       (walk_kind == ClearingWalk::kAuto && use_blocks))) {
+    std::size_t walked = 0;
+    const std::size_t budget = walk_kind == ClearingWalk::kReverseQuery
+                                   ? box_cells  // all of them: never falls back
+                                   : steps / kAutoRayCellsPerChangeableCell;
+    if (clearByReverseQuery(sc, box, budget, &s, &walked)) {
+      stats.cells_cleared = walked;
+      for (const std::uint32_t i : flagged) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
+      return stats;
+    }
   }
   if (mark_sweep) {
     if (s.crossed.size() != geometry.cellCount()) s.crossed.assign(geometry.cellCount(), 0);

@@ -159,6 +159,12 @@ struct IntegrationScratch {
   std::vector<DirectedRay> directed;
   std::vector<std::uint32_t> key_buckets;  ///< first ray of each key bucket
   std::vector<std::uint32_t> near_rays;    ///< the rays that may reach a run of cells
+  struct QueryBlock {
+    int x0, y0, x1, y1;   ///< the block's cells in the box: [x0, x1) x [y0, y1)
+    std::uint32_t masks;  ///< its first row mask in query_masks
+  };
+  std::vector<QueryBlock> query_blocks;  ///< blocks with changeable cells
+  std::vector<std::uint32_t> query_masks;
   std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
 };
 
