@@ -1100,23 +1100,39 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, std::size_t
       candidates(x0, y0, x1, y1, 0, all, block_r);
       const double reach = maxLength2(block_r);
       if (reach * (1.0 + kEps) < distance2(x0, y0, x1, y1)) continue;
-      for (int y = y0; y < y1; ++y) {
-        std::uint32_t mask = masks[y - y0];
-        std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x;
+      // The changeable cells in runs along rows, or along columns where those are fewer (the
+      // cells behind a wall parallel to y): per run, its candidate rays whose box of cells meets
+      // it; none (the common case), nothing in the run can be cleared.
+      const int rows = y1 - y0;
+      int row_runs = 0;
+      for (int y = 0; y < rows; ++y) row_runs += __builtin_popcount(masks[y] & ~(masks[y] << 1));
+      std::uint32_t cols[kBlock] = {};
+      int col_runs = row_runs;
+      if (row_runs > 2) {
+        std::copy(masks, masks + rows, cols);
+        transpose32(cols);
+        col_runs = 0;
+        for (int x = 0; x < kBlock; ++x) col_runs += __builtin_popcount(cols[x] & ~(cols[x] << 1));
+      }
+      const bool by_columns = col_runs < row_runs;
+      const int lines = by_columns ? x1 - x0 : rows;
+      for (int line = 0; line < lines; ++line) {
+        std::uint32_t mask = by_columns ? cols[line] : masks[line];
         while (mask != 0) {
-          // A run of changeable cells [xs, xe) in this row: its candidate rays whose box of cells
-          // (start to end cell) meets the run; none, nothing in the run can be cleared.
           const int s0 = __builtin_ctz(mask);
           const std::uint32_t rest = ~(mask >> s0);
           const int len = rest == 0 ? 32 - s0 : __builtin_ctz(rest);
           mask = len + s0 >= 32 ? 0 : mask & ~(((1u << len) - 1) << s0);
-          const int xs = x0 + s0;
-          const int xe = xs + len;
+          // The run's cells [xs, xe) x [ys, ye).
+          const int xs = by_columns ? x0 + line : x0 + s0;
+          const int xe = by_columns ? xs + 1 : xs + len;
+          const int ys = by_columns ? y0 + s0 : y0 + line;
+          const int ye = by_columns ? ys + len : ys + 1;
           std::ptrdiff_t r[4];
           if (block_r[2] == block_r[3]) {
-            candidates(xs, y, xe, y + 1, block_r[0], block_r[1], r);
+            candidates(xs, ys, xe, ye, block_r[0], block_r[1], r);
           } else {
-            candidates(xs, y, xe, y + 1, 0, all, r);
+            candidates(xs, ys, xe, ye, 0, all, r);
           }
           near.clear();
           for (int part = 0; part < 2; ++part) {
@@ -1125,17 +1141,20 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, std::size_t
               const RayWalk& w = ray.walk;
               const int ex = w.endX();
               const int ey = w.endY();
-              if (y < std::min(w.cy, ey) || y > std::max(w.cy, ey)) continue;
+              if (ye - 1 < std::min(w.cy, ey) || ys > std::max(w.cy, ey)) continue;
               if (xe - 1 < std::min(w.cx, ex) || xs > std::max(w.cx, ex)) continue;
               near.push_back(dir[i].ray);
             }
           }
           if (near.empty()) continue;
-          for (int x = xs; x < xe; ++x) {
-            for (const std::uint32_t k : near) {
-              if (rayClears(rays[k], x, y)) {
-                if (!sc.skipsMiss(row[x])) sc.clear(row + x);  // unless an other ray's
-                break;
+          for (int y = ys; y < ye; ++y) {
+            std::int16_t* row = sc.cells + static_cast<std::ptrdiff_t>(y) * sc.size_x;
+            for (int x = xs; x < xe; ++x) {
+              for (const std::uint32_t k : near) {
+                if (rayClears(rays[k], x, y)) {
+                  if (!sc.skipsMiss(row[x])) sc.clear(row + x);  // unless an other ray's
+                  break;
+                }
               }
             }
           }
