@@ -1095,11 +1095,23 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, std::size_t
       const int x1 = qb.x1;
       const int y1 = qb.y1;
       const std::uint32_t* masks = qmasks.data() + qb.masks;
-      // The block's candidate rays; none reaching as far as the block: nothing to clear here.
+      // The rectangle of the block's changeable cells, its candidate rays; none reaching as far
+      // as the rectangle: nothing to clear here.
+      int ry0 = y1;
+      int ry1 = y0;
+      std::uint32_t used = 0;
+      for (int y = y0; y < y1; ++y) {
+        if (masks[y - y0] == 0) continue;
+        ry0 = std::min(ry0, y);
+        ry1 = y + 1;
+        used |= masks[y - y0];
+      }
+      const int rx0 = x0 + __builtin_ctz(used);
+      const int rx1 = x0 + kBlock - __builtin_clz(used);
       std::ptrdiff_t block_r[4];
-      candidates(x0, y0, x1, y1, 0, all, block_r);
+      candidates(rx0, ry0, rx1, ry1, 0, all, block_r);
       const double reach = maxLength2(block_r);
-      if (reach * (1.0 + kEps) < distance2(x0, y0, x1, y1)) continue;
+      if (reach * (1.0 + kEps) < distance2(rx0, ry0, rx1, ry1)) continue;
       // The changeable cells in runs along rows, or along columns where those are fewer (the
       // cells behind a wall parallel to y): per run, its candidate rays whose box of cells meets
       // it; none (the common case), nothing in the run can be cleared.
