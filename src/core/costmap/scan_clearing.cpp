@@ -920,8 +920,10 @@ inline bool allSaturatedFree(const ScanCells& sc, const std::int16_t* row, int r
 // cells, counted as the per-ray walk counts them) to *walked_out. Returns false, having changed
 // nothing, when the box holds more than max_changeable cells a miss could change (a scan over
 // space the grid has not saturated yet: each costs a query, the forward walks are cheaper).
-bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, std::size_t max_changeable,
-                         IntegrationScratch* s, std::size_t* walked_out) {
+bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, int size_y,
+                         std::size_t max_changeable, IntegrationScratch* s,
+                         std::size_t* walked_out) {
+  const int blocks_x = static_cast<int>((sc.size_x + kBlock - 1) >> kBlockShift);
   const std::vector<ClearingRay>& rays = s->rays;
   std::vector<IntegrationScratch::DirectedRay>& dir = s->directed;
   std::vector<ClearingRay>& aside = s->rays_aside;
@@ -960,10 +962,17 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, std::size_t
       // is saturated free (most blocks in steady state), then the masks.
       const int xa = bx << kBlockShift;
       const bool whole_rows = xa + kBlock <= sc.size_x;
-      if (whole_rows &&
-          allSaturatedFree(sc, sc.cells + static_cast<std::ptrdiff_t>(y0) * sc.size_x + xa,
-                           y1 - y0)) {
-        continue;
+      if (whole_rows) {
+        // Remembered from an earlier scan, or all of the grid's block found saturated now.
+        std::uint8_t& known_free = s->block_free[static_cast<std::size_t>(by) * blocks_x + bx];
+        if (known_free) continue;
+        const int ya = by << kBlockShift;
+        const int yb = std::min(size_y, ya + kBlock);
+        if (allSaturatedFree(sc, sc.cells + static_cast<std::ptrdiff_t>(ya) * sc.size_x + xa,
+                             yb - ya)) {
+          known_free = 1;
+          continue;
+        }
       }
       const std::uint32_t in_box = bitRange(x0 - xa, x1 - 1 - xa);
       const std::size_t offset = qmasks.size();
@@ -1191,7 +1200,24 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
   // limited to 2^28 cells).
   std::vector<std::uint32_t>& flagged = s.flagged;
   flagged.clear();
+  // The per-block memory of saturated blocks holds if nothing changed the grid since the last
+  // scan through this scratch (rawCells() below moves the stamp; recorded again on return).
+  const bool memory_valid =
+      s.stamp_id == grid.stamp().id && s.stamp_version == grid.stamp().version;
   std::int16_t* cells = grid.rawCells();
+  struct RecordStamp {
+    IntegrationScratch* s;
+    const LogOddsGrid* grid;
+    ~RecordStamp() {
+      s->stamp_id = grid->stamp().id;
+      s->stamp_version = grid->stamp().version;
+    }
+  } record_stamp{&s, &grid};
+  const int memory_blocks_x = static_cast<int>((geometry.sizeX() + kBlock - 1) >> kBlockShift);
+  const std::size_t memory_blocks =
+      static_cast<std::size_t>(memory_blocks_x) *
+      static_cast<std::size_t>((geometry.sizeY() + kBlock - 1) >> kBlockShift);
+  if (!memory_valid || s.block_free.size() != memory_blocks) s.block_free.assign(memory_blocks, 0);
   const int free_units = grid.freeUnits();
   const int occupied_units = grid.occupiedUnits();
   const ScanCells sc{cells,
@@ -1216,6 +1242,8 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     if (cells[i] & 1) continue;
     ++stats.cells_marked;
     stats.touched.expand(c.x, c.y);
+    s.block_free[static_cast<std::size_t>(c.y >> kBlockShift) * memory_blocks_x +
+                 (c.x >> kBlockShift)] = 0;
     if (sc.update(i, hit)) {
       ++stats.cells_changed;
       stats.changed.expand(c.x, c.y);
@@ -1295,7 +1323,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     const std::size_t budget = walk_kind == ClearingWalk::kReverseQuery
                                    ? box_cells  // all of them: never falls back
                                    : steps / kAutoRayCellsPerChangeableCell;
-    if (clearByReverseQuery(sc, box, budget, &s, &walked)) {
+    if (clearByReverseQuery(sc, box, static_cast<int>(geometry.sizeY()), budget, &s, &walked)) {
       stats.cells_cleared = walked;
       for (const std::uint32_t i : flagged) cells[i] = static_cast<std::int16_t>(cells[i] & ~1);
       return stats;

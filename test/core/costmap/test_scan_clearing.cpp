@@ -443,3 +443,44 @@ TEST(ScanClearing, AutoTakesMarkSweepForDenseRaysOverUnseenSpace) {
   ASSERT_EQ(scratch.crossed.size(), g.cellCount());
   for (const std::uint8_t mark : scratch.crossed) ASSERT_EQ(mark, 0);
 }
+
+TEST(ScanClearing, ReverseQueryForgetsSaturatedBlocksWhenTheGridChanges) {
+  // The reverse query remembers which blocks are all saturated free from one scan to the next.
+  // Any change of the grid between scans (a cell set, a decay, an assignment) must drop that
+  // memory: a cell set back to unknown inside a remembered block must take its miss again.
+  const GridGeometry g(160, 150, 0.05, -4.0, -3.7);
+  LogOddsGrid per_ray(g);
+  LogOddsGrid reverse(g);
+  IntegrationScratch scratch;
+  std::mt19937 rng(21);
+  const auto check = [&](int s) {
+    auto scan = randomScan(&rng, 0.013, -0.021, 3600, 2.5);
+    for (BeamUpdate& b : scan) {  // no hits within 1.8 m: the blocks there saturate free
+      if (std::hypot(b.end_x - b.start_x, b.end_y - b.start_y) < 1.8) b.mark = false;
+    }
+    const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats b = integrateBeams(reverse, scan, &scratch, ClearingWalk::kReverseQuery);
+    expectSameStats(b, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i)
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+  };
+  for (int s = 0; s < 30; ++s) check(s);  // saturates the disc around the sensor
+  const std::size_t near_sensor = g.index(85, 72);
+  ASSERT_EQ(reverse.units(near_sensor), reverse.clampMinUnits());
+  for (int s = 30; s < 36; ++s) {
+    // Back to unknown near the sensor, in both, in a different way each time.
+    if (s % 3 == 0) {
+      per_ray.setLogOdds(near_sensor, 0.0);
+      reverse.setLogOdds(near_sensor, 0.0);
+    } else if (s % 3 == 1) {
+      per_ray.decay(0.5, CellBounds{80, 70, 90, 75});
+      reverse.decay(0.5, CellBounds{80, 70, 90, 75});
+    } else {
+      LogOddsGrid other = reverse;
+      other.setLogOdds(near_sensor, 0.0);
+      reverse = other;
+      per_ray.setLogOdds(near_sensor, 0.0);
+    }
+    check(s);
+  }
+}

@@ -163,6 +163,13 @@ struct IntegrationScratch {
     int x0, y0, x1, y1;   ///< the block's cells in the box: [x0, x1) x [y0, y1)
     std::uint32_t masks;  ///< its first row mask in query_masks
   };
+  /// Per block of the grid (kBlock cells square; the last column of blocks only if whole): 1 if
+  /// all its cells are saturated free, as found by a reverse query and kept by every scan since
+  /// (a hit clears its block's entry; misses cannot take a cell off the lower clamp). Valid while
+  /// the grid's stamp is the one recorded after the last scan (stamp_id, stamp_version).
+  std::vector<std::uint8_t> block_free;
+  std::uint64_t stamp_id = 0;
+  std::uint64_t stamp_version = 0;
   std::vector<QueryBlock> query_blocks;  ///< blocks with changeable cells
   std::vector<std::uint32_t> query_masks;
   std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
