@@ -867,11 +867,60 @@ inline double pseudoAngle(double dx, double dy) {
   return dx < 0 ? 2.0 - dy / (-dx - dy) : 3.0 + dx / (dx - dy);
 }
 
-// Whether the walk of `ray` (no corners) visits cell (x, y) and clears it: a cell before its end
-// cell, or its end cell when the ray clears that too. The walk reaches (a, b) (x and y steps from
-// its start) exactly when its a-th x crossing comes before its (b+1)-th y crossing and its b-th y
-// crossing before its (a+1)-th x crossing; the (a'+1)-th x crossing comes before the (b'+1)-th y
-// crossing exactly when err + a' esx - b' esy <= 0 (blockExit's order rule). In 128 bits.
+// The diagonal steps of a walk through lattice corners (its visits are its crossings minus
+// those): the corners its walk crosses with two or more crossings left, i.e. the states (a, b)
+// with a, b >= 0, a + b <= stepsLeft() - 2 and err + a esx - b esy == tie (see rayClears), the
+// solutions of a |dy| - b |dx| = (tie - err) / kOne: one every (|dx|, |dy|) / gcd, counted
+// from a particular solution (extended Euclid), in 128 bits.
+inline std::int64_t diagonalSteps(const RayWalk& w) {
+  if (!w.corners) return 0;
+  // |dx|, |dy| < 2^43 (the grid's limits): Euclid's coefficients stay below them, in 64 bits.
+  const std::int64_t ady = w.err_step_x >> RayWalk::kShift;
+  const std::int64_t adx = w.err_step_y >> RayWalk::kShift;
+  const Int128 c = static_cast<Int128>((w.tie - w.err) / RayWalk::kOne);  // exact: corners
+  // s ady + t adx = g
+  std::int64_t r0 = ady;
+  std::int64_t r1 = adx;
+  std::int64_t s0 = 1;
+  std::int64_t s1 = 0;
+  std::int64_t t0 = 0;
+  std::int64_t t1 = 1;
+  while (r1 != 0) {
+    const std::int64_t q = r0 / r1;
+    const std::int64_t r2 = r0 - q * r1;
+    r0 = r1;
+    r1 = r2;
+    const std::int64_t s2 = s0 - q * s1;
+    s0 = s1;
+    s1 = s2;
+    const std::int64_t t2 = t0 - q * t1;
+    t0 = t1;
+    t1 = t2;
+  }
+  const std::int64_t g = r0;  // > 0: corners needs both extents
+  // |c| < 2^63 / kOne: the remainder and quotient in 64 bits.
+  const std::int64_t c64 = static_cast<std::int64_t>(c);
+  if (c64 % g != 0) return 0;
+  const Int128 a0 = static_cast<Int128>(s0) * (c64 / g);
+  const Int128 b0 = -static_cast<Int128>(t0) * (c64 / g);  // ady a0 - adx b0 = c
+  const Int128 p = adx / g;
+  const Int128 q = ady / g;
+  const auto floorDiv = [](Int128 n, Int128 d) { return n / d - ((n % d != 0) && (n < 0)); };
+  const auto ceilDiv = [&floorDiv](Int128 n, Int128 d) { return -floorDiv(-n, d); };
+  const Int128 k_min = std::max(ceilDiv(-a0, p), ceilDiv(-b0, q));
+  const Int128 k_max = floorDiv(static_cast<Int128>(w.stepsLeft()) - 2 - a0 - b0, p + q);
+  return k_max < k_min ? 0 : static_cast<std::int64_t>(k_max - k_min + 1);
+}
+
+// Whether the walk of `ray` visits cell (x, y) and clears it: a cell before its end cell, or its
+// end cell when the ray clears that too. The walk is in cell (a, b) (x and y steps from its start)
+// from the later of its a-th x crossing and b-th y crossing to the earlier of its (a+1)-th x and
+// (b+1)-th y crossing, and visits it when that is a span, not an instant (a corner crossed
+// diagonally touches its two side cells at one point). The (a'+1)-th x crossing comes before
+// the (b'+1)-th y crossing exactly when v = err + a' esx - b' esy < tie, at the same point (a
+// corner) when v == tie (blockExit's order rule with RayWalk's tie; a ray without corners never
+// has v == tie, and for it the rule is the plain one). A corner with one crossing left (at the
+// end point) is the end cell's business, decided by the bounds. In 128 bits.
 inline bool rayClears(const ClearingRay& ray, int x, int y) {
   const RayWalk& w = ray.walk;
   const int a = (x - w.cx) * w.sx;
@@ -880,14 +929,16 @@ inline bool rayClears(const ClearingRay& ray, int x, int y) {
   const int n = a + b;
   const int left = w.stepsLeft();
   if (n == left) return ray.clear_end_cell;  // the end cell (a, b both at their ends)
+  // Entered through its x edge: the a-th x crossing strictly before the (b+1)-th y crossing.
   if (a > 0 && static_cast<Int128>(w.err) + static_cast<Int128>(a - 1) * w.err_step_x -
-                       static_cast<Int128>(b) * w.err_step_y >
-                   0) {
+                       static_cast<Int128>(b) * w.err_step_y >=
+                   w.tie) {
     return false;
   }
+  // And the b-th y crossing strictly before the (a+1)-th x crossing.
   if (b > 0 && static_cast<Int128>(w.err) + static_cast<Int128>(a) * w.err_step_x -
                        static_cast<Int128>(b - 1) * w.err_step_y <=
-                   0) {
+                   w.tie) {
     return false;
   }
   return true;
@@ -935,11 +986,12 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, int size_y,
   const std::int64_t oy = s->ray_origin[1];
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const ClearingRay& ray = rays[i];
-    if (ray.walk.corners || !s->same_origin[i] || ray.walk.stepsLeft() == 0) {
+    if (!s->same_origin[i] || ray.walk.stepsLeft() == 0) {
       aside.push_back(ray);
       continue;
     }
-    walked += static_cast<std::size_t>(ray.walk.stepsLeft()) + (ray.clear_end_cell ? 1 : 0);
+    walked += static_cast<std::size_t>(ray.walk.stepsLeft() - diagonalSteps(ray.walk)) +
+              (ray.clear_end_cell ? 1 : 0);
     // The direction in fixed point: err_step_x = kOne |dy|, err_step_y = kOne |dx| (exact).
     const double dx = static_cast<double>(ray.walk.sx * (ray.walk.err_step_y >> RayWalk::kShift));
     const double dy = static_cast<double>(ray.walk.sy * (ray.walk.err_step_x >> RayWalk::kShift));
