@@ -32,8 +32,9 @@
 // statistics are the per-ray walk's bit for bit (cells_cleared counts visits: a ray's crossings
 // minus its diagonal corner steps); only the order of the flag list differs. kAuto falls back to
 // the block walk when the box holds more than one changeable cell per 32 ray cells (a scene the
-// grid has not saturated yet). 3600-beam room, one thread, alternating rounds: 0.38-0.45 ms
-// against the block walk's 0.73-0.80 ms.
+// grid has not saturated yet) or more than one ray in 8 starts elsewhere (a moving sensor's scan).
+// 3600-beam room, one thread, alternating rounds: 0.38-0.45 ms against the block walk's 0.73-0.80
+// ms.
 //
 // Dense scans can share the walk with a helper thread in bands of block rows (walkRaysInBands):
 // the same grid and statistics, since each cell takes at most one update per scan whatever the
@@ -352,6 +353,8 @@ constexpr int kSaturationSamples = 16;  // per axis
 // could change per this many ray cells (3600-beam room in steady state: ~25 k such cells, ~1.8 M
 // ray cells; the query costs ~7 ns per such cell, the block walk ~0.3 ns per ray cell).
 constexpr std::size_t kAutoRayCellsPerChangeableCell = 32;
+// ... and while at most one ray in this many starts elsewhere than the scan's common start.
+constexpr std::size_t kAutoMaxAsideShare = 8;
 
 // Share of the box's cells (a regular sample) that sit at the lower clamp.
 double saturatedFreeShare(const ScanCells& sc, const CellBounds& box) {
@@ -1013,6 +1016,11 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, int size_y,
     const double dy = static_cast<double>(ray.walk.sy * (ray.walk.err_step_x >> RayWalk::kShift));
     dir.push_back({pseudoAngle(dx, dy), dx * dx + dy * dy, static_cast<std::uint32_t>(i)});
   }
+  // Many rays from other starts (a moving sensor's scan) when it may decline (max_changeable below
+  // the box's cells: kAuto): the query leaves those to the per-ray walk, the block walk is faster.
+  const std::size_t box_cells = static_cast<std::size_t>(box.max_x - box.min_x + 1) *
+                                static_cast<std::size_t>(box.max_y - box.min_y + 1);
+  if (max_changeable < box_cells && aside.size() * kAutoMaxAsideShare > rays.size()) return false;
   // The blocks of the box with cells a miss could change, and their row masks (bit 0 at the
   // block's first column in the box); the count decides whether the query pays.
   std::vector<IntegrationScratch::QueryBlock>& qblocks = s->query_blocks;
