@@ -1014,7 +1014,10 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, int size_y,
     // The direction in fixed point: err_step_x = kOne |dy|, err_step_y = kOne |dx| (exact).
     const double dx = static_cast<double>(ray.walk.sx * (ray.walk.err_step_y >> RayWalk::kShift));
     const double dy = static_cast<double>(ray.walk.sy * (ray.walk.err_step_x >> RayWalk::kShift));
-    dir.push_back({pseudoAngle(dx, dy), dx * dx + dy * dy, static_cast<std::uint32_t>(i)});
+    const RayWalk& w = ray.walk;
+    dir.push_back({pseudoAngle(dx, dy), dx * dx + dy * dy, static_cast<std::uint32_t>(i),
+                   std::min(w.cx, w.endX()), std::min(w.cy, w.endY()), std::max(w.cx, w.endX()),
+                   std::max(w.cy, w.endY())});
   }
   // Many rays from other starts (a moving sensor's scan) when it may decline (max_changeable below
   // the box's cells: kAuto): the query leaves those to the per-ray walk, the block walk is faster.
@@ -1234,13 +1237,9 @@ bool clearByReverseQuery(const ScanCells& sc, const CellBounds& box, int size_y,
           near.clear();
           for (int part = 0; part < 2; ++part) {
             for (std::ptrdiff_t i = r[2 * part]; i < r[2 * part + 1]; ++i) {
-              const ClearingRay& ray = rays[dir[i].ray];
-              const RayWalk& w = ray.walk;
-              const int ex = w.endX();
-              const int ey = w.endY();
-              if (ye - 1 < std::min(w.cy, ey) || ys > std::max(w.cy, ey)) continue;
-              if (xe - 1 < std::min(w.cx, ex) || xs > std::max(w.cx, ex)) continue;
-              near.push_back(dir[i].ray);
+              const IntegrationScratch::DirectedRay& d = dir[i];
+              if (ye <= d.min_y || ys > d.max_y || xe <= d.min_x || xs > d.max_x) continue;
+              near.push_back(d.ray);
             }
           }
           if (near.empty()) continue;

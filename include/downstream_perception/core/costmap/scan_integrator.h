@@ -155,6 +155,7 @@ struct IntegrationScratch {
     double key;      ///< pseudo-angle of the direction, [0, 4)
     double length2;  ///< squared length (fixed point)
     std::uint32_t ray;
+    int min_x, min_y, max_x, max_y;  ///< the box of its start and end cells (its cells lie in it)
   };
   std::vector<DirectedRay> directed;
   std::vector<std::uint32_t> key_buckets;  ///< first ray of each key bucket
