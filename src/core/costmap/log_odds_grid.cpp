@@ -3,6 +3,7 @@
 #include "downstream_perception/core/grid/grid_shift.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -35,6 +36,11 @@ std::string LogOddsConfig::validate() const {
   return why.str();
 }
 
+std::uint64_t LogOddsGrid::Stamp::next() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
 int LogOddsGrid::quantize(double log_odds) {
   const double units = std::round(log_odds / kQuantum);
   return static_cast<int>(
@@ -55,6 +61,7 @@ LogOddsGrid::LogOddsGrid(const GridGeometry& geometry, const LogOddsConfig& conf
 }
 
 void LogOddsGrid::applyConfig(const LogOddsConfig& config) {
+  ++stamp_.version;
   const std::string why = config.validate();
   if (!why.empty()) throw std::invalid_argument(why);
   config_ = config;
@@ -67,6 +74,7 @@ void LogOddsGrid::applyConfig(const LogOddsConfig& config) {
 }
 
 void LogOddsGrid::setConfig(const LogOddsConfig& config) {
+  ++stamp_.version;
   applyConfig(config);
   for (auto& raw : cells_) {
     const int v = std::clamp(unitsOfRaw(raw), clamp_min_units_, clamp_max_units_);
@@ -75,15 +83,18 @@ void LogOddsGrid::setConfig(const LogOddsConfig& config) {
 }
 
 void LogOddsGrid::resize(const GridGeometry& geometry) {
+  ++stamp_.version;
   geometry_ = geometry;
   cells_.assign(geometry.cellCount(), 0);
 }
 
 void LogOddsGrid::reset() {
+  ++stamp_.version;
   std::fill(cells_.begin(), cells_.end(), 0);
 }
 
 void LogOddsGrid::setLogOdds(std::size_t i, double log_odds) {
+  ++stamp_.version;
   const int v = std::clamp(quantize(log_odds), clamp_min_units_, clamp_max_units_);
   cells_[i] = static_cast<std::int16_t>(v * 2);
 }
@@ -109,6 +120,7 @@ void LogOddsGrid::countStates(std::size_t* free_cells, std::size_t* occupied_cel
 }
 
 CellBounds LogOddsGrid::decay(double factor, const CellBounds& window, std::size_t* changed_cells) {
+  ++stamp_.version;
   CellBounds changed;
   if (!(factor >= 0.0 && factor <= 1.0)) {
     throw std::invalid_argument("LogOddsGrid::decay: factor must be in [0, 1], got " +
@@ -142,6 +154,7 @@ CellBounds LogOddsGrid::decay(double factor, const CellBounds& window, std::size
 }
 
 void LogOddsGrid::shift(int dx, int dy) {
+  ++stamp_.version;
   // The new geometry first: if its origin is not finite it throws and nothing has moved.
   const GridGeometry shifted = shiftedGeometry(geometry_, dx, dy);
   shiftGridData(&cells_, geometry_.sizeX(), geometry_.sizeY(), dx, dy, std::int16_t{0});

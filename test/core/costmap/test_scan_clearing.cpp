@@ -119,6 +119,8 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
   LogOddsGrid threaded_first_visit(g, model);
   LogOddsGrid swept(g, model);
   LogOddsGrid first_visit(g, model);
+  LogOddsGrid reverse(g, model);
+  IntegrationScratch reverse_scratch;
   std::vector<int> oracle(g.cellCount(), 0);
   IntegrationScratch scratch;  // reused across scans, as the integrator does
   IntegrationScratch auto_scratch;
@@ -160,6 +162,8 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
         integrateBeams(swept, scan, &sweep_scratch, ClearingWalk::kMarkSweep);
     const IntegrationStats h_first =
         integrateBeams(first_visit, scan, nullptr, ClearingWalk::kFirstVisit);
+    const IntegrationStats i_reverse =
+        integrateBeams(reverse, scan, &reverse_scratch, ClearingWalk::kReverseQuery);
     const std::vector<int> before = oracle;
     oracleIntegrate(g, per_ray, &oracle, scan);
     // The oracle's statistics: cells whose state class (free / unknown / occupied) changed.
@@ -185,6 +189,7 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
     expectSameStats(f, b);
     expectSameStats(g_swept, b);
     expectSameStats(h_first, b);
+    expectSameStats(i_reverse, b);
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
@@ -196,6 +201,7 @@ void compareWalks(unsigned seed, const GridGeometry& g, int scans, int beams, bo
       ASSERT_EQ(swept.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(first_visit.rawCells()[i], per_ray.rawCells()[i])
           << "seed " << seed << " scan " << s;
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "seed " << seed << " scan " << s;
       ASSERT_EQ(blocks.units(i), oracle[i]) << "seed " << seed << " scan " << s << " cell " << i;
     }
   }
@@ -268,13 +274,20 @@ TEST(ScanClearing, AxisAlignedAndSingleCellRays) {
     d.clear_end_cell = k % 2 == 0;
     scan.push_back(d);
   }
+  LogOddsGrid reverse(g);
   IntegrationScratch scratch;
+  IntegrationScratch reverse_scratch;
   for (int round = 0; round < 12; ++round) {
     const IntegrationStats a = integrateBeams(blocks, scan, &scratch, ClearingWalk::kBlockSkip);
     const IntegrationStats b = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats c =
+        integrateBeams(reverse, scan, &reverse_scratch, ClearingWalk::kReverseQuery);
     expectSameStats(a, b);
-    for (std::size_t i = 0; i < g.cellCount(); ++i)
+    expectSameStats(c, b);
+    for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]);
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]);
+    }
   }
   // 12 misses at -0.405 each saturate nothing (clamp -8 needs 20): the swept column is free.
   EXPECT_EQ(blocks.state(g.index(0, 30)), CellState::kFree);
@@ -361,8 +374,10 @@ TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
   LogOddsGrid per_ray(g);
   LogOddsGrid blocks(g);
   LogOddsGrid threaded(g);
+  LogOddsGrid reverse(g);
   IntegrationScratch block_scratch;
   IntegrationScratch threaded_scratch;
+  IntegrationScratch reverse_scratch;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> spot(-1.5, 1.5);
   std::normal_distribution<double> noise(0.0, 0.01);
@@ -394,12 +409,16 @@ TEST(ScanClearing, RaysEndingInFrontOfUnseenCellsMatchThePerRayWalk) {
     const IntegrationStats c =
         integrateBeams(threaded, scan, &threaded_scratch, ClearingWalk::kBlockSkip, 2, 0);
     expectSameStats(b, a);
+    const IntegrationStats d =
+        integrateBeams(reverse, scan, &reverse_scratch, ClearingWalk::kReverseQuery);
     expectSameStats(c, a);
+    expectSameStats(d, a);
     ASSERT_FALSE(threaded_scratch.bands.empty());
     expectBandsStayInTheirRows(threaded_scratch, g.sizeX());
     for (std::size_t i = 0; i < g.cellCount(); ++i) {
       ASSERT_EQ(blocks.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
       ASSERT_EQ(threaded.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
     }
   }
   // The outside stayed unseen and the walls occupied.
@@ -423,4 +442,121 @@ TEST(ScanClearing, AutoTakesMarkSweepForDenseRaysOverUnseenSpace) {
   integrateBeams(grid, randomScan(&rng, 0.01, 0.02, 3600, 7.0), &scratch, ClearingWalk::kAuto);
   ASSERT_EQ(scratch.crossed.size(), g.cellCount());
   for (const std::uint8_t mark : scratch.crossed) ASSERT_EQ(mark, 0);
+}
+
+TEST(ScanClearing, ReverseQueryForgetsSaturatedBlocksWhenTheGridChanges) {
+  // The reverse query remembers which blocks are all saturated free from one scan to the next.
+  // Any change of the grid between scans (a cell set, a decay, an assignment) must drop that
+  // memory: a cell set back to unknown inside a remembered block must take its miss again.
+  const GridGeometry g(160, 150, 0.05, -4.0, -3.7);
+  LogOddsGrid per_ray(g);
+  LogOddsGrid reverse(g);
+  IntegrationScratch scratch;
+  std::mt19937 rng(21);
+  const auto check = [&](int s) {
+    auto scan = randomScan(&rng, 0.013, -0.021, 3600, 2.5);
+    for (BeamUpdate& b : scan) {  // no hits within 1.8 m: the blocks there saturate free
+      if (std::hypot(b.end_x - b.start_x, b.end_y - b.start_y) < 1.8) b.mark = false;
+    }
+    const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats b = integrateBeams(reverse, scan, &scratch, ClearingWalk::kReverseQuery);
+    expectSameStats(b, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i)
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+  };
+  for (int s = 0; s < 30; ++s) check(s);  // saturates the disc around the sensor
+  const std::size_t near_sensor = g.index(85, 72);
+  ASSERT_EQ(reverse.units(near_sensor), reverse.clampMinUnits());
+  for (int s = 30; s < 36; ++s) {
+    // Back to unknown near the sensor, in both, in a different way each time.
+    if (s % 3 == 0) {
+      per_ray.setLogOdds(near_sensor, 0.0);
+      reverse.setLogOdds(near_sensor, 0.0);
+    } else if (s % 3 == 1) {
+      per_ray.decay(0.5, CellBounds{80, 70, 90, 75});
+      reverse.decay(0.5, CellBounds{80, 70, 90, 75});
+    } else {
+      LogOddsGrid other = reverse;
+      other.setLogOdds(near_sensor, 0.0);
+      reverse = other;
+      per_ray.setLogOdds(near_sensor, 0.0);
+    }
+    check(s);
+  }
+}
+
+TEST(ScanClearing, ReverseQueryMatchesOnRaysThroughLatticeCorners) {
+  // Rays from a lattice point to lattice points: many pass exactly through cell corners, where
+  // the walk steps diagonally (RayWalk's tie); the reverse query must visit (and count) exactly
+  // the walk's cells. Repeated, so the free space saturates and the query's skips matter.
+  const GridGeometry g(120, 110, 0.05, -3.0, -2.75);
+  LogOddsGrid per_ray(g);
+  LogOddsGrid reverse(g);
+  IntegrationScratch scratch;
+  std::vector<BeamUpdate> scan;
+  const double ox = 0.0;  // a lattice point (cell corner)
+  const double oy = 0.0;
+  for (int i = -55; i <= 55; i += 1) {
+    for (int j = -50; j <= 50; j += 7) {
+      if (i == 0 && j == 0) continue;
+      for (const auto& [ex, ey] : {std::make_pair(i, j), std::make_pair(j, i)}) {
+        BeamUpdate b;
+        b.start_x = ox;
+        b.start_y = oy;
+        b.end_x = ox + 0.05 * ex;
+        b.end_y = oy + 0.05 * ey;
+        b.clear = true;
+        b.mark = (i + j) % 3 != 0;
+        b.clear_end_cell = (i + j) % 3 == 0;
+        b.hit_x = b.end_x;
+        b.hit_y = b.end_y;
+        scan.push_back(b);
+      }
+    }
+  }
+  for (int s = 0; s < 25; ++s) {
+    const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats b = integrateBeams(reverse, scan, &scratch, ClearingWalk::kReverseQuery);
+    expectSameStats(b, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i)
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+  }
+}
+
+TEST(ScanClearing, ReverseQueryLeavesTheSideCellsOfACornerAlone) {
+  // Few rays through corners, apart from each other far from the start: a side cell of a corner
+  // the walk crosses diagonally is no other ray's cell, so a query that visited it would differ.
+  const GridGeometry g(120, 110, 0.05, -3.0, -2.75);
+  LogOddsGrid per_ray(g);
+  LogOddsGrid reverse(g);
+  IntegrationScratch scratch;
+  std::vector<BeamUpdate> scan;
+  const int dirs[][2] = {{1, 1}, {2, 1}, {1, 2}, {3, 2}, {2, 3}, {5, 1}};
+  for (const auto& d : dirs) {
+    for (const int sx : {-1, 1}) {
+      for (const int sy : {-1, 1}) {
+        for (const int k : {4, 9, 15}) {
+          const int ex = sx * d[0] * k;
+          const int ey = sy * d[1] * k;
+          if (std::abs(ex) > 55 || std::abs(ey) > 50) continue;
+          BeamUpdate b;
+          b.end_x = 0.05 * ex;  // from (0, 0), a cell corner
+          b.end_y = 0.05 * ey;
+          b.clear = true;
+          b.mark = k != 9;
+          b.clear_end_cell = k == 9;
+          b.hit_x = b.end_x;
+          b.hit_y = b.end_y;
+          scan.push_back(b);
+        }
+      }
+    }
+  }
+  for (int s = 0; s < 3; ++s) {
+    const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats b = integrateBeams(reverse, scan, &scratch, ClearingWalk::kReverseQuery);
+    expectSameStats(b, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i)
+      ASSERT_EQ(reverse.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+  }
 }

@@ -80,6 +80,7 @@ class LogOddsGrid {
   void setLogOdds(std::size_t i, double log_odds);
   /// Adds a signed number of quanta, clamped. Returns the new value in quanta.
   int addUnits(std::size_t i, int delta) {
+    ++stamp_.version;
     const std::int16_t raw = cells_[i];
     int v = unitsOfRaw(raw) + delta;
     if (v > clamp_max_units_) v = clamp_max_units_;
@@ -92,11 +93,21 @@ class LogOddsGrid {
 
   // --- scratch flag (used by the integrator to touch a cell once per scan) ---
   bool flagged(std::size_t i) const { return (cells_[i] & 1) != 0; }
-  void setFlag(std::size_t i) { cells_[i] = static_cast<std::int16_t>(cells_[i] | 1); }
-  void clearFlag(std::size_t i) { cells_[i] = static_cast<std::int16_t>(cells_[i] & ~1); }
+  void setFlag(std::size_t i) {
+    ++stamp_.version;
+    cells_[i] = static_cast<std::int16_t>(cells_[i] | 1);
+  }
+  void clearFlag(std::size_t i) {
+    ++stamp_.version;
+    cells_[i] = static_cast<std::int16_t>(cells_[i] & ~1);
+  }
 
-  /// Raw storage (value * 2 + flag), for the integrator's inner loop only.
-  std::int16_t* rawCells() { return cells_.data(); }
+  /// Raw storage (value * 2 + flag), for the integrator's inner loop only. Counts as a change of
+  /// the cells (see stamp()): write through the pointer only before the next call of a method.
+  std::int16_t* rawCells() {
+    ++stamp_.version;
+    return cells_.data();
+  }
   const std::int16_t* rawCells() const { return cells_.data(); }
   int occupiedUnits() const { return occupied_units_; }
   int freeUnits() const { return free_units_; }
@@ -119,6 +130,24 @@ class LogOddsGrid {
   /// be finite.
   void shift(int dx, int dy);
 
+  /// Identifies the grid's cells as they are now: every non-const method (rawCells() included)
+  /// moves `version`, and a copy or an assignment gets a new `id` (unique per process), so equal
+  /// (id, version) means the same cells, unchanged since (the integrator's per-block memory of
+  /// saturated blocks, see IntegrationScratch::block_free, relies on it).
+  struct Stamp {
+    std::uint64_t id = next();
+    std::uint64_t version = 0;
+    Stamp() = default;
+    Stamp(const Stamp&) : id(next()) {}
+    Stamp& operator=(const Stamp&) {
+      id = next();
+      version = 0;
+      return *this;
+    }
+    static std::uint64_t next();
+  };
+  const Stamp& stamp() const { return stamp_; }
+
  private:
   static int unitsOfRaw(std::int16_t raw) { return (raw - (raw & 1)) / 2; }
   void applyConfig(const LogOddsConfig& config);
@@ -126,6 +155,7 @@ class LogOddsGrid {
   GridGeometry geometry_;
   LogOddsConfig config_;
   std::vector<std::int16_t> cells_;
+  Stamp stamp_;
   int hit_units_ = 0;
   int miss_units_ = 0;
   int clamp_min_units_ = 0;

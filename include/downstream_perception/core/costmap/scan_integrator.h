@@ -99,6 +99,12 @@ enum class ClearingWalk {
   /// the grid has hardly seen, where most visits update; kAuto takes it where less than a quarter
   /// of the box is saturated free and the mark-sweep does not pay.
   kFirstVisit,
+  /// Reverse query (issue 20 spike): the rays sharing one start point are sorted by direction;
+  /// every cell of their box a miss could change (not flagged, not saturated free) asks the rays
+  /// whose direction meets it whether their exact walk visits it before its end cell (an O(1)
+  /// integer test, the walk's own order rule). Other rays (another start, lattice corners) are
+  /// walked per ray first. Same grid and statistics as the per-ray walk; the flag order differs.
+  kReverseQuery,
 };
 
 /// ClearingWalk::kAuto's choice, from the rays' cells (steps summed over the rays), the cells of
@@ -141,6 +147,33 @@ struct IntegrationScratch {
   std::vector<Band> bands;
   std::vector<ClearingRay> rays_serial;  ///< rays through lattice corners that cross a band edge
   std::vector<double> row_work;          ///< the rays' cells per row, to place the band edges
+  /// Reverse query: per ray whether it starts at the scan's common start point (ray_origin, fixed
+  /// point); the rays it queries, by direction.
+  std::vector<std::uint8_t> same_origin;
+  std::int64_t ray_origin[2] = {0, 0};
+  struct DirectedRay {
+    double key;      ///< pseudo-angle of the direction, [0, 4)
+    double length2;  ///< squared length (fixed point)
+    std::uint32_t ray;
+    int min_x, min_y, max_x, max_y;  ///< the box of its start and end cells (its cells lie in it)
+  };
+  std::vector<DirectedRay> directed;
+  std::vector<std::uint32_t> key_buckets;  ///< first ray of each key bucket
+  std::vector<std::uint32_t> near_rays;    ///< the rays that may reach a run of cells
+  struct QueryBlock {
+    int x0, y0, x1, y1;   ///< the block's cells in the box: [x0, x1) x [y0, y1)
+    std::uint32_t masks;  ///< its first row mask in query_masks
+  };
+  /// Per block of the grid (kBlock cells square; the last column of blocks only if whole): 1 if
+  /// all its cells are saturated free, as found by a reverse query and kept by every scan since
+  /// (a hit clears its block's entry; misses cannot take a cell off the lower clamp). Valid while
+  /// the grid's stamp is the one recorded after the last scan (stamp_id, stamp_version).
+  std::vector<std::uint8_t> block_free;
+  std::uint64_t stamp_id = 0;
+  std::uint64_t stamp_version = 0;
+  std::vector<QueryBlock> query_blocks;  ///< blocks with changeable cells
+  std::vector<std::uint32_t> query_masks;
+  std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
 };
 
 /// The two-thread clearing walk starts at this many ray cells per scan: below it, waking the
