@@ -19,22 +19,22 @@
 // per-ray walk's, bit for bit (test_scan_clearing checks this against the per-ray walk and a plain
 // oracle on random scans and on rooms).
 //
-// The reverse query (issue 20 spike, ClearingWalk::kReverseQuery; kAuto takes it where it took the
-// block walk). In a steady scene few cells can still change (obstacle shadows, the cells at and
-// behind the walls, noise), so instead of walking the rays over the cells, the cells ask the
-// rays: the rays from the scan's common start are sorted by direction (a pseudo-angle, no
-// trigonometry), the box is scanned for blocks holding a cell a miss could change (blocks found
-// all saturated free are remembered across scans while the grid's stamp says nothing else changed
-// it; a hit forgets its block), and each run of such cells in a row (or column) takes the rays
-// whose direction can meet it and whose box of cells does; for those few the exact visit test
-// (rayClears: the walk's own integer order rule, with its corner tie) decides per cell. Rays from
-// another start are walked per ray first. Each cell takes the same one miss, so the grid and the
-// statistics are the per-ray walk's bit for bit (cells_cleared counts visits: a ray's crossings
-// minus its diagonal corner steps); only the order of the flag list differs. kAuto falls back to
-// the block walk when the box holds more than one changeable cell per 32 ray cells (a scene the
-// grid has not saturated yet) or more than one ray in 8 starts elsewhere (a moving sensor's scan).
-// 3600-beam room, one thread, alternating rounds: 0.38-0.45 ms against the block walk's 0.73-0.80
-// ms.
+// The reverse query (issue 20, ClearingWalk::kReverseQuery; kAuto takes it where it took the
+// block walk and the box has few changeable cells, on one thread: it beats the two-thread walk). In
+// a steady scene few cells can still change (obstacle shadows, the cells at and behind the walls,
+// noise), so instead of walking the rays over the cells, the cells ask the rays: the rays from the
+// scan's common start are sorted by direction (a pseudo-angle, no trigonometry), the box is scanned
+// for blocks holding a cell a miss could change (blocks found all saturated free are remembered
+// across scans while the grid's stamp says nothing else changed it; a hit forgets its block), and
+// each run of such cells in a row (or column) takes the rays whose direction can meet it and whose
+// box of cells does; for those few the exact visit test (rayClears: the walk's own integer order
+// rule, with its corner tie) decides per cell. Rays from another start are walked per ray first.
+// Each cell takes the same one miss, so the grid and the statistics are the per-ray walk's bit for
+// bit (cells_cleared counts visits: a ray's crossings minus its diagonal corner steps); only the
+// order of the flag list differs. kAuto falls back to the block walk when the box holds more than
+// one changeable cell per 32 ray cells (a scene the grid has not saturated yet) or more than one
+// ray in 8 starts elsewhere (a moving sensor's scan). 3600-beam room, one thread, alternating
+// rounds: 0.38-0.45 ms against the block walk's 0.73-0.80 ms.
 //
 // Dense scans can share the walk with a helper thread in bands of block rows (walkRaysInBands):
 // the same grid and statistics, since each cell takes at most one update per scan whatever the
@@ -877,7 +877,7 @@ std::size_t walkRaysInBands(const ScanCells& sc, const Blocks& blocks, RayWalkKi
   return walked;
 }
 
-// --- Reverse query (ClearingWalk::kReverseQuery, issue 20 spike) ---
+// --- Reverse query (ClearingWalk::kReverseQuery, issue 20) ---
 
 // A pseudo-angle of the direction (dx, dy) in [0, 4): monotone in atan2 over a turn starting at
 // +x (the "diamond angle"), one division, no trigonometry. Not defined at (0, 0).

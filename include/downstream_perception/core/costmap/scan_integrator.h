@@ -99,7 +99,7 @@ enum class ClearingWalk {
   /// the grid has hardly seen, where most visits update; kAuto takes it where less than a quarter
   /// of the box is saturated free and the mark-sweep does not pay.
   kFirstVisit,
-  /// Reverse query (issue 20 spike): the rays sharing one start point are sorted by direction;
+  /// Reverse query (issue 20): the rays sharing one start point are sorted by direction;
   /// every cell of their box a miss could change (not flagged, not saturated free) asks the rays
   /// whose direction meets it whether their exact walk visits it before its end cell (an O(1)
   /// integer test, the walk's own order rule). Other rays (another start, lattice corners) are
