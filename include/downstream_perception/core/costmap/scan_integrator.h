@@ -161,8 +161,11 @@ struct IntegrationScratch {
   std::vector<std::uint32_t> key_buckets;  ///< first ray of each key bucket
   std::vector<std::uint32_t> near_rays;    ///< the rays that may reach a run of cells
   struct QueryBlock {
-    int x0, y0, x1, y1;   ///< the block's cells in the box: [x0, x1) x [y0, y1)
-    std::uint32_t masks;  ///< its first row mask in query_masks
+    int x0, y0, x1, y1;        ///< the block's cells in the box: [x0, x1) x [y0, y1)
+    std::uint32_t masks;       ///< its first row mask in query_masks
+    std::uint32_t changeable;  ///< its cells a miss could change
+    bool reached;              ///< some ray reaches as far as its changeable cells
+    std::ptrdiff_t rays[4];    ///< the candidate rays of those cells (two ranges of directed)
   };
   /// Per block of the grid (kBlock cells square; the last column of blocks only if whole): 1 if
   /// all its cells are saturated free, as found by a reverse query and kept by every scan since
