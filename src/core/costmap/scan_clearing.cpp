@@ -31,10 +31,10 @@
 // rule, with its corner tie) decides per cell. Rays from another start are walked per ray first.
 // Each cell takes the same one miss, so the grid and the statistics are the per-ray walk's bit for
 // bit (cells_cleared counts visits: a ray's crossings minus its diagonal corner steps); only the
-// order of the flag list differs. kAuto falls back to the block walk when the box holds more than
-// one changeable cell per 32 ray cells (a scene the grid has not saturated yet) or more than one
-// ray in 8 starts elsewhere (a moving sensor's scan). 3600-beam room, one thread, alternating
-// rounds: 0.38-0.45 ms against the block walk's 0.73-0.80 ms.
+// order of the flag list differs. kAuto falls back to the block walk when the blocks the rays reach
+// hold more than one changeable cell per 16 ray cells (a scene the grid has not saturated yet) or
+// more than one ray in 8 starts elsewhere (a moving sensor's scan). 3600-beam room, one thread,
+// alternating rounds: 0.38-0.45 ms against the block walk's 0.73-0.80 ms.
 //
 // Dense scans can share the walk with a helper thread in bands of block rows (walkRaysInBands):
 // the same grid and statistics, since each cell takes at most one update per scan whatever the
