@@ -14,6 +14,7 @@
 #include "downstream_perception/core/tsdf/esdf.h"
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
+#include "tsdf_test_helpers.h"
 
 namespace downstream_perception {
 namespace test {
@@ -43,6 +44,23 @@ struct RoomScene {
     return std::min(d, outside + std::min(std::max(radial, vertical), 0.0));
   }
 };
+
+/// The room's exact SDF written into a TSDF at `voxel_m`: D = clamp(sdf / mu), observed down to
+/// mu behind every surface (deeper voxels stay unknown, as the weight drop-off leaves them).
+inline TsdfMap filledRoom(double voxel_m, const RoomScene& scene) {
+  TsdfConfig c;
+  c.voxel_size_m = voxel_m;
+  TsdfMap map(c);
+  const double mu = c.truncation();
+  const int lo = static_cast<int>(std::floor(-2.4 / voxel_m));
+  const int hi = static_cast<int>(std::ceil(2.4 / voxel_m));
+  fill(&map, {lo, lo, static_cast<int>(std::floor(-0.4 / voxel_m))},
+       {hi, hi, static_cast<int>(std::ceil(3.4 / voxel_m))}, [&](const Eigen::Vector3d& p) {
+         const double sdf = scene(p);
+         return sdf < -mu ? std::nan("") : std::clamp(sdf / mu, -1.0, 1.0);
+       });
+  return map;
+}
 
 /// T_map_camera of an optical frame (z forward, y down) at `eye` looking at `target`.
 inline Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {

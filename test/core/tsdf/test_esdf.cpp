@@ -50,27 +50,6 @@ TEST(DistanceTransform3d, MatchesBruteForceOnRandomSeeds) {
   EXPECT_GT(within, 1000u);  // the test sees real distances, not only seeds and "far"
 }
 
-namespace {
-
-/// The room's exact SDF written into a TSDF at `voxel_m`: D = clamp(sdf / mu), observed down to
-/// mu behind every surface (deeper voxels stay unknown, as the weight drop-off leaves them).
-TsdfMap filledRoom(double voxel_m, const RoomScene& scene) {
-  TsdfConfig c;
-  c.voxel_size_m = voxel_m;
-  TsdfMap map(c);
-  const double mu = c.truncation();
-  const int lo = static_cast<int>(std::floor(-2.4 / voxel_m));
-  const int hi = static_cast<int>(std::ceil(2.4 / voxel_m));
-  fill(&map, {lo, lo, static_cast<int>(std::floor(-0.4 / voxel_m))},
-       {hi, hi, static_cast<int>(std::ceil(3.4 / voxel_m))}, [&](const Eigen::Vector3d& p) {
-         const double sdf = scene(p);
-         return sdf < -mu ? std::nan("") : std::clamp(sdf / mu, -1.0, 1.0);
-       });
-  return map;
-}
-
-}  // namespace
-
 class EsdfRoomOffsets : public ::testing::TestWithParam<Eigen::Vector3d> {};
 
 TEST_P(EsdfRoomOffsets, FullComputationMatchesTheOracle) {

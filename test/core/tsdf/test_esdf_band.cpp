@@ -93,22 +93,6 @@ BandOracle compareBandWithOracle(const TsdfMap& map, const EsdfBandConfig& c,
   return result;
 }
 
-/// The room's exact SDF in a TSDF, observed down to mu behind every surface.
-TsdfMap filledRoom(double voxel_m, const RoomScene& scene) {
-  TsdfConfig c;
-  c.voxel_size_m = voxel_m;
-  TsdfMap map(c);
-  const double mu = c.truncation();
-  const int lo = static_cast<int>(std::floor(-2.4 / voxel_m));
-  const int hi = static_cast<int>(std::ceil(2.4 / voxel_m));
-  fill(&map, {lo, lo, static_cast<int>(std::floor(-0.4 / voxel_m))},
-       {hi, hi, static_cast<int>(std::ceil(3.4 / voxel_m))}, [&](const Eigen::Vector3d& p) {
-         const double sdf = scene(p);
-         return sdf < -mu ? std::nan("") : std::clamp(sdf / mu, -1.0, 1.0);
-       });
-  return map;
-}
-
 }  // namespace
 
 TEST(EsdfBand, WallDistancesAreHandDerivedAndTheFloorAndAShelfAboveAreNoObstacles) {
