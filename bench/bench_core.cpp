@@ -85,8 +85,9 @@ std::uint64_t checksumOf(const T* data, std::size_t n) {
 // timed: the write over the whole window the scan touched (costmap_2d merges that window every
 // update) and the first scan into an empty (all-unknown) grid. Each update runs twice, in turn,
 // on two grids fed the same scans: with the automatic clearing walk (what the layer runs: the
-// block skip for dense scans) and with the per-ray walk (the reference, as before issue 20), so
-// both are timed in the same rounds; the grids' checksums show they stay bit-identical.
+// walk it times as fastest, auto_walk_runs says which ran) and with the per-ray walk (the
+// reference, as before issue 20), so both are timed in the same rounds; the grids' checksums show
+// they stay bit-identical.
 void runIntegration(int size, double room_half, int beams, int iters) {
   const GridGeometry geometry(size, size, 0.05, -size * 0.025, -size * 0.025);
   ScanIntegratorConfig config;
@@ -147,6 +148,7 @@ void runIntegration(int size, double room_half, int beams, int iters) {
     }
   }
   const double median = medianOf(sides[0].integrate_ms);
+  const auto& runs = integrator.walkChooser().runs();
   const double cells_per_scan = static_cast<double>(cells) / iters;
   const std::size_t n = geometry.cellCount();
   const std::uint64_t sum = checksumOf(sides[0].grid.rawCells(), n);
@@ -161,14 +163,18 @@ void runIntegration(int size, double room_half, int beams, int iters) {
       "\"per_ray_first_scan_ms\": %.4f, \"cells_per_scan\": %.0f, "
       "\"cells_changed_per_scan\": %.1f, \"mcells_per_s\": %.1f, \"grid_checksum\": \"%016llx\", "
       "\"per_ray_grid_checksum\": \"%016llx\", \"master_checksum\": \"%016llx\", "
-      "\"per_ray_master_checksum\": \"%016llx\"}\n",
+      "\"per_ray_master_checksum\": \"%016llx\", \"auto_walk_runs\": {\"per_ray\": %llu, "
+      "\"blocks\": %llu, \"reverse_query\": %llu}}\n",
       size, room_half, beams, iters, median, p90Of(sides[0].integrate_ms),
       medianOf(sides[0].layer_ms), medianOf(sides[1].integrate_ms), medianOf(sides[1].layer_ms),
       medianOf(touched_write_ms), medianOf(first), medianOf(first_per_ray), cells_per_scan,
       static_cast<double>(changed) / iters, cells_per_scan / (median * 1e-3) / 1e6,
       static_cast<unsigned long long>(sum), static_cast<unsigned long long>(sum_per_ray),
       static_cast<unsigned long long>(master_sum),
-      static_cast<unsigned long long>(master_sum_per_ray));
+      static_cast<unsigned long long>(master_sum_per_ray),
+      static_cast<unsigned long long>(runs[WalkChooser::kPerRay]),
+      static_cast<unsigned long long>(runs[WalkChooser::kBlocks]),
+      static_cast<unsigned long long>(runs[WalkChooser::kReverseQuery]));
 }
 
 // One whole costmap update as our costmap runs it on the anchor scenario (static map,

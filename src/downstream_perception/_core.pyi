@@ -1117,6 +1117,11 @@ class ScanIntegrator:
         """
     @threads.setter
     def threads(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    @property
+    def walk_runs(self) -> dict:
+        """
+        scans over seen space walked by each clearing walk, as timed and chosen by the integrator (per_ray, blocks, reverse_query); the grid is the same whichever ran
+        """
 
 class StaticMapConfig:
     """

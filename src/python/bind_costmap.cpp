@@ -226,6 +226,18 @@ void bindScanIntegration(py::module& m) {
                     "threads of the clearing walk: 1, or 2 (the default where the machine has "
                     "two cores) for dense scans (200,000 ray cells or more); the grid is the same "
                     "bit for bit")
+      .def_property_readonly(
+          "walk_runs",
+          [](const ScanIntegrator& self) {
+            const auto& runs = self.walkChooser().runs();
+            py::dict d;
+            d["per_ray"] = runs[WalkChooser::kPerRay];
+            d["blocks"] = runs[WalkChooser::kBlocks];
+            d["reverse_query"] = runs[WalkChooser::kReverseQuery];
+            return d;
+          },
+          "scans over seen space walked by each clearing walk, as timed and chosen by the "
+          "integrator (per_ray, blocks, reverse_query); the grid is the same whichever ran")
       .def(
           "integrate",
           [](ScanIntegrator& self, LogOddsGrid& grid,

@@ -31,10 +31,15 @@
 // rule, with its corner tie) decides per cell. Rays from another start are walked per ray first.
 // Each cell takes the same one miss, so the grid and the statistics are the per-ray walk's bit for
 // bit (cells_cleared counts visits: a ray's crossings minus its diagonal corner steps); only the
-// order of the flag list differs. kAuto falls back to the block walk when the blocks the rays reach
-// hold more than one changeable cell per 16 ray cells (a scene the grid has not saturated yet) or
+// order of the flag list differs. It falls back to the block walk when the blocks the rays reach
+// hold more than one changeable cell per 4 ray cells (a scene the grid has not saturated yet) or
 // more than one ray in 8 starts elsewhere (a moving sensor's scan). 3600-beam room, one thread,
 // alternating rounds: 0.38-0.45 ms against the block walk's 0.73-0.80 ms.
+//
+// Which walk kAuto runs over seen space (at least a quarter of the box saturated free) is timed,
+// not fixed (WalkChooser, walk_chooser.h): per kind of scan the per-ray walk, the block walk and
+// the reverse query are each measured, the fastest runs, and the others are tried again now and
+// then. The fixed rule below is only the first guess.
 //
 // Dense scans can share the walk with a helper thread in bands of block rows (walkRaysInBands):
 // the same grid and statistics, since each cell takes at most one update per scan whatever the
@@ -42,6 +47,7 @@
 // process, alternating rounds): the masks took our walk from 1.34-1.44 ms to 1.20-1.23 ms (ray
 // cells walked one by one 571 k -> 286 k per scan; costmap_2d's updateBounds 0.80-0.89 ms).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -349,18 +355,42 @@ constexpr std::size_t kAutoBlockWalkNumerator = 1;
 constexpr std::size_t kAutoBlockWalkDenominator = 1;
 constexpr double kAutoMinSaturatedShare = 0.25;
 constexpr int kSaturationSamples = 16;  // per axis
-// kAuto takes the reverse query over the block walk while the blocks the rays reach hold at most
-// one cell a miss could change per this many ray cells. 3600-beam room in steady state: ~25 k
-// such cells in ~1.8 M ray cells; with the beams past 30 m dropped (costmap_2d's default) the
-// unseen wedges and the cells behind the walls add ~70 k, ~95 k in reached blocks, and the query
-// still took 0.54 ms where the block walk took 1.7 ms (costmap_2d side by side: 2.2x; at 1 in 32
-// kAuto declined it there).
-constexpr std::size_t kAutoRayCellsPerChangeableCell = 16;
+// kAuto's reverse query gives up (and the block walk runs) when the blocks the rays reach hold more
+// than one cell a miss could change per this many ray cells. Since the chooser times the walks
+// (walk_chooser.h), this only has to stop hopeless queries; at 1 in 16 (the rule before the
+// chooser, measured on one room) it declined where the query was the fastest walk: a sensor off
+// the room's centre (1000^2, 3600 beams: 0.97 ms block walk, 0.66 ms query) and a sensor on a
+// cell corner (500^2, 1080 beams: 0.58 against 0.51 ms). At 1 in 4 both take the query; the
+// sparse scans where the query loses (5x at 360 beams on 1000^2) still decline.
+constexpr std::size_t kAutoRayCellsPerChangeableCell = 4;
 // ... and while at most one ray in this many starts elsewhere than the scan's common start.
 constexpr std::size_t kAutoMaxAsideShare = 8;
 // The reverse query's collection of changeable blocks gives up early past this many times its
 // budget (the budget counts only the cells the rays reach, known after the collection).
 constexpr std::size_t kEarlyDeclineFactor = 4;
+
+// Reports the time from start() to its end, per ray cell, to the chooser (on every return path).
+class WalkTiming {
+ public:
+  WalkTiming() = default;
+  WalkTiming(const WalkTiming&) = delete;
+  WalkTiming& operator=(const WalkTiming&) = delete;
+  void start(WalkChooser* chooser, std::size_t ray_cells) {
+    chooser_ = chooser;
+    ray_cells_ = std::max<std::size_t>(ray_cells, 1);
+    start_ = std::chrono::steady_clock::now();
+  }
+  ~WalkTiming() {
+    if (chooser_ == nullptr) return;
+    const std::chrono::duration<double, std::nano> took = std::chrono::steady_clock::now() - start_;
+    chooser_->report(took.count() / static_cast<double>(ray_cells_));
+  }
+
+ private:
+  WalkChooser* chooser_ = nullptr;
+  std::size_t ray_cells_ = 1;
+  std::chrono::steady_clock::time_point start_;
+};
 
 // Share of the box's cells (a regular sample) that sit at the lower clamp.
 double saturatedFreeShare(const ScanCells& sc, const CellBounds& box) {
@@ -1394,9 +1424,9 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                                           static_cast<std::size_t>(box.max_y - box.min_y + 1);
   const double saturated_share =
       walk_kind == ClearingWalk::kAuto && !box.empty() ? saturatedFreeShare(sc, box) : 0.0;
-  const bool use_blocks = walk_kind == ClearingWalk::kBlockSkip ||
-                          (walk_kind == ClearingWalk::kAuto && !box.empty() &&
-                           autoChoosesBlockWalk(steps, box_cells, saturated_share));
+  bool use_blocks = walk_kind == ClearingWalk::kBlockSkip ||
+                    (walk_kind == ClearingWalk::kAuto && !box.empty() &&
+                     autoChoosesBlockWalk(steps, box_cells, saturated_share));
   const bool mark_sweep = !use_blocks && !box.empty() &&
                           (walk_kind == ClearingWalk::kMarkSweep ||
                            (walk_kind == ClearingWalk::kAuto &&
@@ -1409,8 +1439,20 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
        (walk_kind == ClearingWalk::kAuto && saturated_share < kAutoMinSaturatedShare));
   // The reverse query where the block walk would run (dense rays over seen space), unless the box
   // holds too many cells a miss could change (then the block walk runs as before).
-  if (!box.empty() && (walk_kind == ClearingWalk::kReverseQuery ||
-                       (walk_kind == ClearingWalk::kAuto && use_blocks))) {
+  bool try_reverse =
+      walk_kind == ClearingWalk::kReverseQuery || (walk_kind == ClearingWalk::kAuto && use_blocks);
+  // Over seen space kAuto's rule above is only the prior: the walks give the same grid, so the
+  // chooser times them and runs the fastest for this kind of scan (walk_chooser.h).
+  WalkTiming timing;
+  if (walk_kind == ClearingWalk::kAuto && !box.empty() && !mark_sweep && !first_visits) {
+    const WalkChooser::Walk prior = use_blocks ? WalkChooser::kReverseQuery : WalkChooser::kPerRay;
+    const WalkChooser::Walk chosen =
+        s.chooser.choose(WalkChooser::contextOf(steps, box_cells), prior);
+    use_blocks = chosen != WalkChooser::kPerRay;
+    try_reverse = chosen == WalkChooser::kReverseQuery;
+    timing.start(&s.chooser, steps);
+  }
+  if (!box.empty() && try_reverse) {
     std::size_t walked = 0;
     const std::size_t budget = walk_kind == ClearingWalk::kReverseQuery
                                    ? box_cells  // all of them: never falls back

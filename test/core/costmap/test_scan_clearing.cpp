@@ -324,6 +324,34 @@ TEST(ScanClearing, AutoTakesTheBlockWalkOnlyForDenseRaysOverSeenSpace) {
   EXPECT_FALSE(autoChoosesBlockWalk(10, 1000, 1.0));
 }
 
+TEST(ScanClearing, AutoTimesEachSteadyWalkAndStaysEqualToThePerRayWalk) {
+  // kAuto's chooser (walk_chooser.h) measures each of the three steady walks on its first scans
+  // of a kind, whatever the clock says; every scan must still equal the per-ray walk.
+  // A steady scene (no hits within 1.8 m, misses that saturate at once): the chooser's regime.
+  const GridGeometry g(200, 170, 0.05, -4.3, -4.1);
+  LogOddsConfig model;
+  model.p_hit = 0.99;
+  model.p_miss = 0.01;
+  model.clamp_min = -2.1;
+  model.clamp_max = 2.1;
+  LogOddsGrid per_ray(g, model);
+  LogOddsGrid automatic(g, model);
+  IntegrationScratch scratch;
+  std::mt19937 rng(5);
+  for (int s = 0; s < 24; ++s) {
+    std::vector<BeamUpdate> scan = randomScan(&rng, 0.013, -0.021, 3600, 2.5);
+    for (BeamUpdate& b : scan) {
+      if (std::hypot(b.end_x - b.start_x, b.end_y - b.start_y) < 1.8) b.mark = false;
+    }
+    const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
+    const IntegrationStats b = integrateBeams(automatic, scan, &scratch, ClearingWalk::kAuto);
+    expectSameStats(b, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i)
+      ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+  }
+  for (int w = 0; w < WalkChooser::kWalks; ++w) EXPECT_GE(scratch.chooser.runs()[w], 2u) << w;
+}
+
 TEST(ScanClearing, TwoThreadsSplitTheRaysAtABlockRow) {
   // A dense scan from the middle of a 200 x 170 grid: rays going up and down, many crossing the
   // split row; the two-thread walk must really split them (else the comparisons above would

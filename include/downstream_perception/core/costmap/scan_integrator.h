@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "downstream_perception/core/costmap/log_odds_grid.h"
+#include "downstream_perception/core/costmap/walk_chooser.h"
 #include "downstream_perception/core/grid/ray_traversal.h"
 #include "downstream_perception/core/grid/se2.h"
 
@@ -177,6 +178,8 @@ struct IntegrationScratch {
   std::vector<QueryBlock> query_blocks;  ///< blocks with changeable cells
   std::vector<std::uint32_t> query_masks;
   std::vector<ClearingRay> rays_aside;  ///< rays the reverse query does not take (walked per ray)
+  /// kAuto's timed choice between the steady scans' walks (walk_chooser.h).
+  WalkChooser chooser;
 };
 
 /// The two-thread clearing walk starts at this many ray cells per scan: below it, waking the
@@ -244,6 +247,8 @@ class ScanIntegrator {
   /// scans only (see integrateBeams); the grid is the same bit for bit.
   void setThreads(int threads) { threads_ = std::max(1, std::min(2, threads)); }
   int threads() const { return threads_; }
+  /// kAuto's timed choice of the steady scans' walk (walk_chooser.h): which ran how often.
+  const WalkChooser& walkChooser() const { return integration_scratch_.chooser; }
 
   /// REP-117 decisions for each beam (see the file comment), with the sensor at `sensor_pose`
   /// in the grid's frame. Appends to *beams; counts ignored beams into *stats.

@@ -1,0 +1,146 @@
+// WalkChooser (walk_chooser.h): kAuto's timed choice between the exact clearing walks. Fed with
+// made-up times, it must explore each walk, settle on the fastest, keep retrying the others at
+// doubling intervals (so their cost stays small), follow a change of scene, ride out a spike and
+// undo a lucky trial; contexts are kept apart.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <vector>
+
+#include "downstream_perception/core/costmap/walk_chooser.h"
+
+using namespace downstream_perception;  // NOLINT
+
+namespace {
+
+using Walk = WalkChooser::Walk;
+using Costs = std::array<double, WalkChooser::kWalks>;
+
+// Runs n scans in `context` where walk k costs costs[k] ns per cell; returns the walks run.
+std::vector<Walk> run(WalkChooser* chooser, std::uint32_t context, Walk prior, const Costs& costs,
+                      int n) {
+  std::vector<Walk> walks;
+  for (int i = 0; i < n; ++i) {
+    const Walk w = chooser->choose(context, prior);
+    chooser->report(costs[w]);
+    walks.push_back(w);
+  }
+  return walks;
+}
+
+int count(const std::vector<Walk>& walks, Walk w, std::size_t from = 0) {
+  int n = 0;
+  for (std::size_t i = from; i < walks.size(); ++i) n += walks[i] == w;
+  return n;
+}
+
+}  // namespace
+
+TEST(WalkChooser, ExploresThePriorFirstThenEachWalkTwice) {
+  WalkChooser chooser;
+  const std::vector<Walk> walks = run(&chooser, 1, WalkChooser::kReverseQuery, {1.0, 2.0, 3.0}, 6);
+  const std::vector<Walk> expected = {WalkChooser::kReverseQuery, WalkChooser::kReverseQuery,
+                                      WalkChooser::kPerRay,       WalkChooser::kPerRay,
+                                      WalkChooser::kBlocks,       WalkChooser::kBlocks};
+  EXPECT_EQ(walks, expected);
+  EXPECT_DOUBLE_EQ(chooser.figure(1, WalkChooser::kBlocks), 2.0);
+  EXPECT_DOUBLE_EQ(chooser.figure(1, WalkChooser::kPerRay), 1.0);
+  EXPECT_LT(chooser.figure(2, WalkChooser::kPerRay), 0.0);  // another context: never measured
+}
+
+TEST(WalkChooser, SettlesOnTheFastestAndRetriesTheOthersAtDoublingIntervals) {
+  WalkChooser chooser;
+  const std::vector<Walk> walks = run(&chooser, 7, WalkChooser::kPerRay, {1.0, 2.0, 0.5}, 2000);
+  // After the 6 exploring scans: retries after 16, 32, 64, 128, 256, 256, ... scans per walk.
+  const int slower = count(walks, WalkChooser::kPerRay, 6) + count(walks, WalkChooser::kBlocks, 6);
+  EXPECT_GE(slower, 2 * 8);   // each slower walk is still tried now and then ...
+  EXPECT_LE(slower, 2 * 14);  // ... but rarely: at most ~1 scan in 70 here
+  EXPECT_LE(count(walks, WalkChooser::kBlocks, 1000), 5);  // past the doubling: one in 256
+  EXPECT_EQ(chooser.runs()[WalkChooser::kReverseQuery],
+            static_cast<std::uint64_t>(count(walks, WalkChooser::kReverseQuery)));
+}
+
+TEST(WalkChooser, FollowsAChangeOfScene) {
+  WalkChooser chooser;
+  run(&chooser, 3, WalkChooser::kReverseQuery, {1.0, 2.0, 0.5}, 3000);
+  // The scene changes: the per-ray walk is now the fastest. Its next retry is at most 256 scans
+  // away; from then on it runs.
+  const std::vector<Walk> walks =
+      run(&chooser, 3, WalkChooser::kReverseQuery, {0.3, 2.0, 0.5}, 600);
+  EXPECT_GE(count(walks, WalkChooser::kPerRay, 300), 295);
+}
+
+TEST(WalkChooser, OneSlowScanOfTheFastestWalkDoesNotDethroneIt) {
+  WalkChooser chooser;
+  run(&chooser, 4, WalkChooser::kPerRay, {1.0, 2.0, 0.5}, 100);
+  // One preempted scan of the running walk, 100x its time: capped at 3x, averaged in.
+  const Walk w = chooser.choose(4, WalkChooser::kPerRay);
+  ASSERT_EQ(w, WalkChooser::kReverseQuery);
+  chooser.report(50.0);
+  EXPECT_LT(chooser.figure(4, WalkChooser::kReverseQuery), 1.0);
+  EXPECT_EQ(chooser.choose(4, WalkChooser::kPerRay), WalkChooser::kReverseQuery);
+  chooser.report(0.5);
+}
+
+TEST(WalkChooser, ALuckyTrialIsUndoneSoon) {
+  WalkChooser chooser;
+  const Costs costs = {1.0, 2.0, 0.5};
+  run(&chooser, 5, WalkChooser::kPerRay, costs, 6);
+  // The blocks' first retry comes 16 scans after exploring; make that one sample look fast.
+  int scans = 0;
+  for (;; ++scans) {
+    ASSERT_LT(scans, 100);
+    const Walk w = chooser.choose(5, WalkChooser::kPerRay);
+    if (w == WalkChooser::kBlocks) {
+      chooser.report(0.1);  // lucky
+      break;
+    }
+    chooser.report(costs[w]);
+  }
+  EXPECT_EQ(chooser.choose(5, WalkChooser::kPerRay), WalkChooser::kBlocks);  // believed, at first
+  chooser.report(costs[WalkChooser::kBlocks]);
+  // Its real figures come in (each capped at 3x its figure, so a few scans) and the reverse
+  // query's old figure is faster again: back to it, the blocks tried again 16 scans later.
+  const std::vector<Walk> after = run(&chooser, 5, WalkChooser::kPerRay, costs, 40);
+  EXPECT_LE(count(after, WalkChooser::kBlocks), 6);
+  EXPECT_GE(count(after, WalkChooser::kReverseQuery, 10), 27);
+}
+
+TEST(WalkChooser, KeepsContextsApart) {
+  WalkChooser chooser;
+  const std::uint32_t sparse = WalkChooser::contextOf(100000, 1000000);
+  const std::uint32_t dense = WalkChooser::contextOf(2000000, 1000000);
+  ASSERT_NE(sparse, dense);
+  EXPECT_EQ(WalkChooser::contextOf(100000, 1000000), WalkChooser::contextOf(120000, 1040000));
+  // Two sensors in turn: each kind of scan settles on its own fastest walk.
+  std::vector<Walk> sparse_walks;
+  std::vector<Walk> dense_walks;
+  for (int i = 0; i < 400; ++i) {
+    const Walk a = chooser.choose(sparse, WalkChooser::kPerRay);
+    chooser.report(a == WalkChooser::kPerRay ? 1.0 : 3.0);
+    sparse_walks.push_back(a);
+    const Walk b = chooser.choose(dense, WalkChooser::kReverseQuery);
+    chooser.report(b == WalkChooser::kReverseQuery ? 0.2 : 1.0);
+    dense_walks.push_back(b);
+  }
+  EXPECT_GE(count(sparse_walks, WalkChooser::kPerRay, 200), 196);
+  EXPECT_GE(count(dense_walks, WalkChooser::kReverseQuery, 200), 196);
+  // More contexts than it keeps: the least recently used is forgotten, the others are not.
+  for (std::uint32_t k = 100; k < 100 + WalkChooser::kContexts - 1; ++k) {
+    run(&chooser, k, WalkChooser::kPerRay, {1.0, 1.0, 1.0}, 1);
+  }
+  EXPECT_LT(chooser.figure(sparse, WalkChooser::kPerRay), 0.0);
+  EXPECT_DOUBLE_EQ(chooser.figure(dense, WalkChooser::kReverseQuery), 0.2);
+}
+
+TEST(WalkChooser, ReportWithoutChoiceOrWithABadFigureIsHarmless) {
+  WalkChooser chooser;
+  chooser.report(1.0);  // nothing chosen: ignored
+  EXPECT_EQ(chooser.runs()[0] + chooser.runs()[1] + chooser.runs()[2], 0u);
+  EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks), WalkChooser::kBlocks);
+  chooser.report(0.0);  // below the clock's resolution: counts as fast, not as unmeasured
+  EXPECT_GT(chooser.figure(9, WalkChooser::kBlocks), 0.0);
+  EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks), WalkChooser::kBlocks);
+  chooser.report(-5.0);
+  EXPECT_GT(chooser.figure(9, WalkChooser::kBlocks), 0.0);
+}
