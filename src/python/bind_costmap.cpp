@@ -234,10 +234,12 @@ void bindScanIntegration(py::module& m) {
             d["per_ray"] = runs[WalkChooser::kPerRay];
             d["blocks"] = runs[WalkChooser::kBlocks];
             d["reverse_query"] = runs[WalkChooser::kReverseQuery];
+            d["first_visit"] = runs[WalkChooser::kFirstVisit];
             return d;
           },
           "scans over seen space walked by each clearing walk, as timed and chosen by the "
-          "integrator (per_ray, blocks, reverse_query); the grid is the same whichever ran")
+          "integrator (per_ray, blocks, reverse_query, first_visit); the grid is the same "
+          "whichever ran")
       .def(
           "integrate",
           [](ScanIntegrator& self, LogOddsGrid& grid,

@@ -36,10 +36,10 @@
 // more than one ray in 8 starts elsewhere (a moving sensor's scan). 3600-beam room, one thread,
 // alternating rounds: 0.38-0.45 ms against the block walk's 0.73-0.80 ms.
 //
-// Which walk kAuto runs over seen space (at least a quarter of the box saturated free) is timed,
-// not fixed (WalkChooser, walk_chooser.h): per kind of scan the per-ray walk, the block walk and
-// the reverse query are each measured, the fastest runs, and the others are tried again now and
-// then. The fixed rule below is only the first guess.
+// Which walk kAuto runs over seen space (at least a quarter of a sample of the rays' cells
+// saturated free) is timed, not fixed (WalkChooser, walk_chooser.h): per kind of scan the per-ray
+// walk, the first-visit walk, the block walk and the reverse query are each measured, the fastest
+// runs, and the others are tried again now and then. The fixed rule below is only the first guess.
 //
 // Dense scans can share the walk with a helper thread in bands of block rows (walkRaysInBands):
 // the same grid and statistics, since each cell takes at most one update per scan whatever the
@@ -143,6 +143,56 @@ struct ScanCells {
   }
 };
 
+// gcd(a, b) if it is at least `floor`, else 0 (a, b > 0). Binary: no division; gcd(a, b) never
+// exceeds min(a, b), so the loop stops as soon as that falls below the floor.
+inline std::int64_t gcdIfAtLeast(std::int64_t a, std::int64_t b, std::int64_t floor) {
+  const int shift = __builtin_ctzll(static_cast<std::uint64_t>(a | b));
+  a >>= __builtin_ctzll(static_cast<std::uint64_t>(a));
+  while (b != 0) {
+    b >>= __builtin_ctzll(static_cast<std::uint64_t>(b));
+    if (a > b) std::swap(a, b);
+    if ((a << shift) < floor) return 0;
+    b -= a;
+  }
+  return a << shift;
+}
+
+// Rays from a sensor standing exactly on a lattice corner (every ray of its scan is then a corner
+// ray, RayWalk::corners). The walk crosses a corner diagonally at the states (a, b) (x and y
+// steps from the start) with a |dy| - b |dx| = c, c = (tie - err) / kOne. From a corner start c
+// is alpha |dx| - beta |dy| with alpha, beta in {0, 1} by the quadrant the ray goes into (the
+// first crossing is a whole cell away along an axis it moves up, none along one it moves down),
+// so the solutions are (k p - beta, k q - alpha), p = |dx| / g, q = |dy| / g, g = gcd(|dx|, |dy|):
+// k = 0 (the start itself, when alpha = beta = 0) and k >= 1 only if p + q fits the crossings left,
+// i.e. g >= (|dx| + |dy|) / room; for a measured direction (|dx|, |dy| about 2^20 per cell) that
+// is a common factor of about 2^20, which gcdIfAtLeast rules out after a few halvings. Whether
+// `w` starts on a corner, and its alpha and beta.
+inline bool startsOnCorner(const RayWalk& w, int* alpha, int* beta) {
+  const std::int64_t ady = w.err_step_x >> RayWalk::kShift;
+  const std::int64_t adx = w.err_step_y >> RayWalk::kShift;
+  const std::int64_t c = (w.tie - w.err) / RayWalk::kOne;  // exact for corner rays
+  for (*alpha = 0; *alpha < 2; ++*alpha) {
+    for (*beta = 0; *beta < 2; ++*beta) {
+      if (c == *alpha * adx - *beta * ady) return true;
+    }
+  }
+  return false;
+}
+
+// Whether a corner ray (RayWalk::corners) may cross a corner diagonally after its first step
+// (else the plain two-way loop walks it exactly once past the start). Conservative: true unless
+// it starts on a corner with no k >= 1 solution.
+inline bool crossesCornerPastStart(const RayWalk& w) {
+  int alpha = 0;
+  int beta = 0;
+  if (!startsOnCorner(w, &alpha, &beta)) return true;
+  const std::int64_t room = static_cast<std::int64_t>(w.stepsLeft()) - 2 + alpha + beta;
+  if (room <= 0) return false;
+  const std::int64_t ady = w.err_step_x >> RayWalk::kShift;
+  const std::int64_t adx = w.err_step_y >> RayWalk::kShift;
+  return gcdIfAtLeast(adx, ady, (adx + ady + room - 1) / room) != 0;
+}
+
 // A ray that may pass exactly through cell corners (lattice-exact points): the walk of
 // RayWalk::walk on the cell pointer, crossing a corner diagonally (see RayWalk); clears every
 // cell before the end cell and returns the end cell's pointer; *visited counts the cells visited.
@@ -178,6 +228,9 @@ __attribute__((noinline)) std::int16_t* clearThroughCorners(const RayWalk& walk,
   return p;
 }
 
+std::int16_t* clearFromCorner(const RayWalk& walk, std::int16_t* p, const ScanCells sc,
+                              std::size_t* walked, bool first_visits);
+
 // Clears every cell of a ray before its end cell and returns the end cell's pointer; the cells
 // visited are added to *walked. The walk moves a cell pointer (+-1 along x, +-size_x along y) and
 // keeps its state in registers; the rare update (a cell not yet saturated free) leaves the hot
@@ -187,7 +240,7 @@ __attribute__((noinline)) std::int16_t* clearThroughCorners(const RayWalk& walk,
 __attribute__((noinline, aligned(64))) std::int16_t* clearAlong(const RayWalk& walk,
                                                                 std::int16_t* p, const ScanCells sc,
                                                                 std::size_t* walked) {
-  if (__builtin_expect(walk.corners, 0)) return clearThroughCorners(walk, p, sc, walked);
+  if (__builtin_expect(walk.corners, 0)) return clearFromCorner(walk, p, sc, walked, false);
   // Pointer steps: +-1 along x, +-size_x along y (see RayWalk for why this is a branch).
   const std::ptrdiff_t dpx = walk.sx;
   const std::ptrdiff_t dpy = walk.sy * sc.size_x;
@@ -217,7 +270,7 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlongFirstVisits(const
                                                                            std::int16_t* p,
                                                                            const ScanCells sc,
                                                                            std::size_t* walked) {
-  if (__builtin_expect(walk.corners, 0)) return clearThroughCorners(walk, p, sc, walked);
+  if (__builtin_expect(walk.corners, 0)) return clearFromCorner(walk, p, sc, walked, true);
   const std::ptrdiff_t dpx = walk.sx;
   const std::ptrdiff_t dpy = walk.sy * sc.size_x;
   const std::int64_t esx = walk.err_step_x;
@@ -243,6 +296,30 @@ __attribute__((noinline, aligned(64))) std::int16_t* clearAlongFirstVisits(const
   }
   sc.addChanged(first_changed, last_changed, changed);
   return p;
+}
+
+// A corner ray (RayWalk::corners) for clearAlong / clearAlongFirstVisits. A sensor standing on a
+// lattice corner (a robot started at the map's origin) makes every ray of its scan one, and such
+// a ray almost never crosses another corner (crossesCornerPastStart): after its first step
+// (diagonal when the start corner is crossed so) the plain loop walks it exactly. 360 beams from a
+// corner of a 1000^2 grid took 1.8x the time from off the corner in clearThroughCorners. Out of
+// line, so the plain loops' code stays as it was (placement-sensitive, see clearAlong).
+__attribute__((noinline)) std::int16_t* clearFromCorner(const RayWalk& walk, std::int16_t* p,
+                                                        const ScanCells sc, std::size_t* walked,
+                                                        bool first_visits) {
+  if (crossesCornerPastStart(walk)) return clearThroughCorners(walk, p, sc, walked);
+  RayWalk rest = walk;
+  rest.corners = false;
+  if (walk.err == walk.tie && walk.stepsLeft() >= 2) {
+    if (!sc.skipsMiss(*p)) sc.clear(p);  // the same grid and statistics as missFirstVisit
+    ++*walked;
+    p += walk.sx + walk.sy * sc.size_x;
+    rest.err += walk.err_step_x - walk.err_step_y;
+    --rest.steps_x;
+    --rest.steps_y;
+  }
+  return first_visits ? clearAlongFirstVisits(rest, p, sc, walked)
+                      : clearAlong(rest, p, sc, walked);
 }
 
 // The mark walk of ClearingWalk::kMarkSweep: the cells of clearAlong / clearThroughCorners (the
@@ -351,11 +428,13 @@ constexpr int kBlock = 1 << kBlockShift;
 // (ratio 2.2) gain 1.8x.
 // And only where blocks can be skipped at all: on a grid that has not seen this area yet (the
 // first scan after start-up, a reset or a resize) no cell is saturated free and counting the
-// blocks is pure cost (first scan 1.4x slower than per ray). A 16 x 16 sample of the box decides.
+// blocks is pure cost (first scan 1.4x slower than per ray). A sample of the rays' cells decides
+// (saturatedRayShare).
 constexpr std::size_t kAutoBlockWalkNumerator = 1;
 constexpr std::size_t kAutoBlockWalkDenominator = 1;
 constexpr double kAutoMinSaturatedShare = 0.25;
-constexpr int kSaturationSamples = 16;  // per axis
+constexpr std::size_t kSaturationSampleRays = 64;
+constexpr int kSaturationSamplesPerRay = 4;
 // kAuto's reverse query gives up (and the block walk runs) when the blocks the rays reach hold more
 // than one cell a miss could change per this many ray cells. Since the chooser times the walks
 // (walk_chooser.h), this only has to stop hopeless queries; at 1 in 16 (the rule before the
@@ -393,21 +472,29 @@ class WalkTiming {
   std::chrono::steady_clock::time_point start_;
 };
 
-// Share of the box's cells (a regular sample) that sit at the lower clamp.
-double saturatedFreeShare(const ScanCells& sc, const CellBounds& box) {
-  const int w = box.max_x - box.min_x + 1;
-  const int h = box.max_y - box.min_y + 1;
-  const int nx = std::min(w, kSaturationSamples);
-  const int ny = std::min(h, kSaturationSamples);
+// Share of a sample of the rays' cells (up to 64 rays spread over the scan, 4 cells each, at 1/8,
+// 3/8, 5/8 and 7/8 of the way to the end cell) that sit at the lower clamp: whether the rays cross
+// space the grid has seen. (A sample of their box, as before, misjudged sparse scans: 360 beams on
+// 1000^2 cross about a quarter of their box, so its share sat at the threshold whatever the rays
+// found, and a sensor on a cell corner took the first-visit walk on every steady scan, 1.8x
+// slower.) The points lie within a cell of the ray's line, close enough for a share.
+double saturatedRayShare(const ScanCells& sc, const std::vector<ClearingRay>& rays) {
+  if (rays.empty()) return 0.0;
+  const std::size_t stride = std::max<std::size_t>(1, rays.size() / kSaturationSampleRays);
   int saturated = 0;
-  for (int j = 0; j < ny; ++j) {
-    const std::ptrdiff_t y = box.min_y + static_cast<std::ptrdiff_t>(j) * h / ny + h / (2 * ny);
-    for (int i = 0; i < nx; ++i) {
-      const std::ptrdiff_t x = box.min_x + static_cast<std::ptrdiff_t>(i) * w / nx + w / (2 * nx);
+  int sampled = 0;
+  for (std::size_t i = stride / 2; i < rays.size(); i += stride) {
+    const RayWalk& w = rays[i].walk;
+    const std::int64_t dx = w.endX() - w.cx;
+    const std::int64_t dy = w.endY() - w.cy;
+    for (int q = 1; q < 2 * kSaturationSamplesPerRay; q += 2) {
+      const std::int64_t x = w.cx + dx * q / (2 * kSaturationSamplesPerRay);
+      const std::int64_t y = w.cy + dy * q / (2 * kSaturationSamplesPerRay);
       saturated += (sc.cells[y * sc.size_x + x] & ~1) == (sc.saturated_free_raw & ~1);
+      ++sampled;
     }
   }
-  return static_cast<double>(saturated) / (nx * ny);
+  return static_cast<double>(saturated) / sampled;
 }
 
 }  // namespace
@@ -927,51 +1014,28 @@ inline double pseudoAngle(double dx, double dy) {
 // those): the corners its walk crosses with two or more crossings left, i.e. the states (a, b)
 // with a, b >= 0, a + b <= stepsLeft() - 2 and err + a esx - b esy == tie (see rayClears), the
 // solutions of a |dy| - b |dx| = (tie - err) / kOne: one every (|dx|, |dy|) / gcd, counted
-// from a particular solution (extended Euclid), in 128 bits.
-//
-// A ray starting on a lattice corner (a sensor there: every ray of its scan) has c = alpha |dx| -
-// beta |dy| with alpha, beta in {0, 1} by the quadrant it goes into (the first crossing is a whole
-// cell away along an axis it moves up, none along one it moves down), so (-beta, -alpha) is a
-// particular solution and k >= 1 solutions exist only if p + q = (|dx| + |dy|) / g fits the
-// crossings left: g at least (|dx| + |dy|) / room, which for a measured direction (|dx|, |dy|
-// about 2^20 per cell) is a common factor of about 2^20 that the gcd loop rules out after a few
-// halvings. Euclid's 64-bit divisions to the end took most of the reverse query's time on such a
-// scan (perf: 3600 beams from a corner of a 200^2 grid, 2x the time from off the corner).
-//
-// gcd(a, b) if it is at least `floor`, else 0 (a, b > 0). Binary: no division; gcd(a, b) never
-// exceeds min(a, b), so the loop stops as soon as that falls below the floor.
-inline std::int64_t gcdIfAtLeast(std::int64_t a, std::int64_t b, std::int64_t floor) {
-  const int shift = __builtin_ctzll(static_cast<std::uint64_t>(a | b));
-  a >>= __builtin_ctzll(static_cast<std::uint64_t>(a));
-  while (b != 0) {
-    b >>= __builtin_ctzll(static_cast<std::uint64_t>(b));
-    if (a > b) std::swap(a, b);
-    if ((a << shift) < floor) return 0;
-    b -= a;
-  }
-  return a << shift;
-}
-
+// from a particular solution (extended Euclid), in 128 bits; for a ray from a corner, in closed
+// form (startsOnCorner: Euclid's 64-bit divisions took most of the reverse query's time on a
+// scan from a corner, perf: 3600 beams on 200^2, 2x the time from off the corner).
 inline std::int64_t diagonalSteps(const RayWalk& w) {
   if (!w.corners) return 0;
   // |dx|, |dy| < 2^43 (the grid's limits): Euclid's coefficients stay below them, in 64 bits.
   const std::int64_t ady = w.err_step_x >> RayWalk::kShift;
   const std::int64_t adx = w.err_step_y >> RayWalk::kShift;
   const Int128 c = static_cast<Int128>((w.tie - w.err) / RayWalk::kOne);  // exact: corners
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    for (int beta = 0; beta < 2; ++beta) {
-      if (c != static_cast<Int128>(alpha * adx - beta * ady)) continue;
-      // Solutions (a, b) = (k p - beta, k q - alpha), p = |dx| / g, q = |dy| / g; a, b >= 0 and
-      // a + b <= stepsLeft() - 2.
-      const std::int64_t room = static_cast<std::int64_t>(w.stepsLeft()) - 2 + alpha + beta;
-      if (room < 0) return 0;
-      // k = 0 is a solution when alpha = beta = 0: the start corner itself, entered diagonally.
-      const std::int64_t at_start = alpha == 0 && beta == 0 ? 1 : 0;
-      if (room == 0) return at_start;
-      const std::int64_t g = gcdIfAtLeast(adx, ady, (adx + ady + room - 1) / room);
-      if (g == 0) return at_start;
-      return at_start + room / (adx / g + ady / g);  // k = 1 .. k_max (k_max >= 1 here)
-    }
+  int alpha = 0;
+  int beta = 0;
+  if (startsOnCorner(w, &alpha, &beta)) {
+    // Solutions (a, b) = (k p - beta, k q - alpha), p = |dx| / g, q = |dy| / g; a, b >= 0 and
+    // a + b <= stepsLeft() - 2. k = 0 is one when alpha = beta = 0: the start corner itself,
+    // entered diagonally.
+    const std::int64_t room = static_cast<std::int64_t>(w.stepsLeft()) - 2 + alpha + beta;
+    if (room < 0) return 0;
+    const std::int64_t at_start = alpha == 0 && beta == 0 ? 1 : 0;
+    if (room == 0) return at_start;
+    const std::int64_t g = gcdIfAtLeast(adx, ady, (adx + ady + room - 1) / room);
+    if (g == 0) return at_start;
+    return at_start + room / (adx / g + ady / g);  // k = 1 .. k_max (k_max >= 1 here)
   }
   // s ady + t adx = g
   std::int64_t r0 = ady;
@@ -1463,7 +1527,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                                     : static_cast<std::size_t>(box.max_x - box.min_x + 1) *
                                           static_cast<std::size_t>(box.max_y - box.min_y + 1);
   const double saturated_share =
-      walk_kind == ClearingWalk::kAuto && !box.empty() ? saturatedFreeShare(sc, box) : 0.0;
+      walk_kind == ClearingWalk::kAuto && !box.empty() ? saturatedRayShare(sc, rays) : 0.0;
   bool use_blocks = walk_kind == ClearingWalk::kBlockSkip ||
                     (walk_kind == ClearingWalk::kAuto && !box.empty() &&
                      autoChoosesBlockWalk(steps, box_cells, saturated_share));
@@ -1473,7 +1537,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
                             autoChoosesMarkSweep(steps, box_cells, saturated_share)));
   // The first-visit walk over space the grid has hardly seen, where the mark-sweep does not pay
   // (sparse rays: the sweep would cost more than the rays).
-  const bool first_visits =
+  bool first_visits =
       !use_blocks && !mark_sweep && !box.empty() &&
       (walk_kind == ClearingWalk::kFirstVisit ||
        (walk_kind == ClearingWalk::kAuto && saturated_share < kAutoMinSaturatedShare));
@@ -1488,8 +1552,9 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
     const WalkChooser::Walk prior = use_blocks ? WalkChooser::kReverseQuery : WalkChooser::kPerRay;
     const WalkChooser::Walk chosen =
         s.chooser.choose(WalkChooser::contextOf(steps, box_cells), prior);
-    use_blocks = chosen != WalkChooser::kPerRay;
+    use_blocks = chosen == WalkChooser::kBlocks || chosen == WalkChooser::kReverseQuery;
     try_reverse = chosen == WalkChooser::kReverseQuery;
+    first_visits = chosen == WalkChooser::kFirstVisit;
     timing.start(&s.chooser, steps);
   }
   if (!box.empty() && try_reverse) {

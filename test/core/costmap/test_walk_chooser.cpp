@@ -38,10 +38,12 @@ int count(const std::vector<Walk>& walks, Walk w, std::size_t from = 0) {
 
 TEST(WalkChooser, ExploresThePriorFirstThenEachWalkTwice) {
   WalkChooser chooser;
-  const std::vector<Walk> walks = run(&chooser, 1, WalkChooser::kReverseQuery, {1.0, 2.0, 3.0}, 6);
+  const std::vector<Walk> walks =
+      run(&chooser, 1, WalkChooser::kReverseQuery, {1.0, 2.0, 3.0, 4.0}, 8);
   const std::vector<Walk> expected = {WalkChooser::kReverseQuery, WalkChooser::kReverseQuery,
                                       WalkChooser::kPerRay,       WalkChooser::kPerRay,
-                                      WalkChooser::kBlocks,       WalkChooser::kBlocks};
+                                      WalkChooser::kBlocks,       WalkChooser::kBlocks,
+                                      WalkChooser::kFirstVisit,   WalkChooser::kFirstVisit};
   EXPECT_EQ(walks, expected);
   EXPECT_DOUBLE_EQ(chooser.figure(1, WalkChooser::kBlocks), 2.0);
   EXPECT_DOUBLE_EQ(chooser.figure(1, WalkChooser::kPerRay), 1.0);
@@ -50,11 +52,13 @@ TEST(WalkChooser, ExploresThePriorFirstThenEachWalkTwice) {
 
 TEST(WalkChooser, SettlesOnTheFastestAndRetriesTheOthersAtDoublingIntervals) {
   WalkChooser chooser;
-  const std::vector<Walk> walks = run(&chooser, 7, WalkChooser::kPerRay, {1.0, 2.0, 0.5}, 2000);
-  // After the 6 exploring scans: retries after 16, 32, 64, 128, 256, 256, ... scans per walk.
-  const int slower = count(walks, WalkChooser::kPerRay, 6) + count(walks, WalkChooser::kBlocks, 6);
-  EXPECT_GE(slower, 2 * 8);   // each slower walk is still tried now and then ...
-  EXPECT_LE(slower, 2 * 14);  // ... but rarely: at most ~1 scan in 70 here
+  const std::vector<Walk> walks =
+      run(&chooser, 7, WalkChooser::kPerRay, {1.0, 2.0, 0.5, 1.5}, 2000);
+  // After the 8 exploring scans: retries after 16, 32, 64, 128, 256, 256, ... scans per walk.
+  const int slower = count(walks, WalkChooser::kPerRay, 8) + count(walks, WalkChooser::kBlocks, 8) +
+                     count(walks, WalkChooser::kFirstVisit, 8);
+  EXPECT_GE(slower, 3 * 8);   // each slower walk is still tried now and then ...
+  EXPECT_LE(slower, 3 * 14);  // ... but rarely: about 1 scan in 65 here
   EXPECT_LE(count(walks, WalkChooser::kBlocks, 1000), 5);  // past the doubling: one in 256
   EXPECT_EQ(chooser.runs()[WalkChooser::kReverseQuery],
             static_cast<std::uint64_t>(count(walks, WalkChooser::kReverseQuery)));
@@ -62,17 +66,17 @@ TEST(WalkChooser, SettlesOnTheFastestAndRetriesTheOthersAtDoublingIntervals) {
 
 TEST(WalkChooser, FollowsAChangeOfScene) {
   WalkChooser chooser;
-  run(&chooser, 3, WalkChooser::kReverseQuery, {1.0, 2.0, 0.5}, 3000);
+  run(&chooser, 3, WalkChooser::kReverseQuery, {1.0, 2.0, 0.5, 1.5}, 3000);
   // The scene changes: the per-ray walk is now the fastest. Its next retry is at most 256 scans
   // away; from then on it runs.
   const std::vector<Walk> walks =
-      run(&chooser, 3, WalkChooser::kReverseQuery, {0.3, 2.0, 0.5}, 600);
-  EXPECT_GE(count(walks, WalkChooser::kPerRay, 300), 295);
+      run(&chooser, 3, WalkChooser::kReverseQuery, {0.3, 2.0, 0.5, 1.5}, 600);
+  EXPECT_GE(count(walks, WalkChooser::kPerRay, 300), 290);
 }
 
 TEST(WalkChooser, OneSlowScanOfTheFastestWalkDoesNotDethroneIt) {
   WalkChooser chooser;
-  run(&chooser, 4, WalkChooser::kPerRay, {1.0, 2.0, 0.5}, 100);
+  run(&chooser, 4, WalkChooser::kPerRay, {1.0, 2.0, 0.5, 1.5}, 100);
   // One preempted scan of the running walk, 100x its time: capped at 3x, averaged in.
   const Walk w = chooser.choose(4, WalkChooser::kPerRay);
   ASSERT_EQ(w, WalkChooser::kReverseQuery);
@@ -84,8 +88,8 @@ TEST(WalkChooser, OneSlowScanOfTheFastestWalkDoesNotDethroneIt) {
 
 TEST(WalkChooser, ALuckyTrialIsUndoneSoon) {
   WalkChooser chooser;
-  const Costs costs = {1.0, 2.0, 0.5};
-  run(&chooser, 5, WalkChooser::kPerRay, costs, 6);
+  const Costs costs = {1.0, 2.0, 0.5, 1.5};
+  run(&chooser, 5, WalkChooser::kPerRay, costs, 8);
   // The blocks' first retry comes 16 scans after exploring; make that one sample look fast.
   int scans = 0;
   for (;; ++scans) {
@@ -103,7 +107,7 @@ TEST(WalkChooser, ALuckyTrialIsUndoneSoon) {
   // query's old figure is faster again: back to it, the blocks tried again 16 scans later.
   const std::vector<Walk> after = run(&chooser, 5, WalkChooser::kPerRay, costs, 40);
   EXPECT_LE(count(after, WalkChooser::kBlocks), 6);
-  EXPECT_GE(count(after, WalkChooser::kReverseQuery, 10), 27);
+  EXPECT_GE(count(after, WalkChooser::kReverseQuery, 10), 26);
 }
 
 TEST(WalkChooser, KeepsContextsApart) {
@@ -123,11 +127,11 @@ TEST(WalkChooser, KeepsContextsApart) {
     chooser.report(b == WalkChooser::kReverseQuery ? 0.2 : 1.0);
     dense_walks.push_back(b);
   }
-  EXPECT_GE(count(sparse_walks, WalkChooser::kPerRay, 200), 196);
-  EXPECT_GE(count(dense_walks, WalkChooser::kReverseQuery, 200), 196);
+  EXPECT_GE(count(sparse_walks, WalkChooser::kPerRay, 200), 195);
+  EXPECT_GE(count(dense_walks, WalkChooser::kReverseQuery, 200), 195);
   // More contexts than it keeps: the least recently used is forgotten, the others are not.
   for (std::uint32_t k = 100; k < 100 + WalkChooser::kContexts - 1; ++k) {
-    run(&chooser, k, WalkChooser::kPerRay, {1.0, 1.0, 1.0}, 1);
+    run(&chooser, k, WalkChooser::kPerRay, {1.0, 1.0, 1.0, 1.0}, 1);
   }
   EXPECT_LT(chooser.figure(sparse, WalkChooser::kPerRay), 0.0);
   EXPECT_DOUBLE_EQ(chooser.figure(dense, WalkChooser::kReverseQuery), 0.2);
@@ -136,7 +140,7 @@ TEST(WalkChooser, KeepsContextsApart) {
 TEST(WalkChooser, ReportWithoutChoiceOrWithABadFigureIsHarmless) {
   WalkChooser chooser;
   chooser.report(1.0);  // nothing chosen: ignored
-  EXPECT_EQ(chooser.runs()[0] + chooser.runs()[1] + chooser.runs()[2], 0u);
+  EXPECT_EQ(chooser.runs()[0] + chooser.runs()[1] + chooser.runs()[2] + chooser.runs()[3], 0u);
   EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks), WalkChooser::kBlocks);
   chooser.report(0.0);  // below the clock's resolution: counts as fast, not as unmeasured
   EXPECT_GT(chooser.figure(9, WalkChooser::kBlocks), 0.0);
