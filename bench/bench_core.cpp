@@ -164,7 +164,8 @@ void runIntegration(int size, double room_half, int beams, int iters) {
       "\"cells_changed_per_scan\": %.1f, \"mcells_per_s\": %.1f, \"grid_checksum\": \"%016llx\", "
       "\"per_ray_grid_checksum\": \"%016llx\", \"master_checksum\": \"%016llx\", "
       "\"per_ray_master_checksum\": \"%016llx\", \"auto_walk_runs\": {\"per_ray\": %llu, "
-      "\"blocks\": %llu, \"reverse_query\": %llu, \"first_visit\": %llu}}\n",
+      "\"blocks\": %llu, \"reverse_query\": %llu, \"first_visit\": %llu, "
+      "\"shared\": %llu}}\n",
       size, room_half, beams, iters, median, p90Of(sides[0].integrate_ms),
       medianOf(sides[0].layer_ms), medianOf(sides[1].integrate_ms), medianOf(sides[1].layer_ms),
       medianOf(touched_write_ms), medianOf(first), medianOf(first_per_ray), cells_per_scan,
@@ -175,7 +176,10 @@ void runIntegration(int size, double room_half, int beams, int iters) {
       static_cast<unsigned long long>(runs[WalkChooser::kPerRay]),
       static_cast<unsigned long long>(runs[WalkChooser::kBlocks]),
       static_cast<unsigned long long>(runs[WalkChooser::kReverseQuery]),
-      static_cast<unsigned long long>(runs[WalkChooser::kFirstVisit]));
+      static_cast<unsigned long long>(runs[WalkChooser::kFirstVisit]),
+      static_cast<unsigned long long>(runs[WalkChooser::kPerRayShared] +
+                                      runs[WalkChooser::kBlocksShared] +
+                                      runs[WalkChooser::kFirstVisitShared]));
 }
 
 // One whole costmap update as our costmap runs it on the anchor scenario (static map,

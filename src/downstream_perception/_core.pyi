@@ -1120,7 +1120,7 @@ class ScanIntegrator:
     @property
     def walk_runs(self) -> dict:
         """
-        scans over seen space walked by each clearing walk, as timed and chosen by the integrator (per_ray, blocks, reverse_query, first_visit); the grid is the same whichever ran
+        scans over seen space walked by each clearing walk, as timed and chosen by the integrator (per_ray, blocks, reverse_query, first_visit; *_shared: on two threads); the grid is the same whichever ran
         """
 
 class StaticMapConfig:

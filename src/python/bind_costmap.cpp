@@ -235,11 +235,14 @@ void bindScanIntegration(py::module& m) {
             d["blocks"] = runs[WalkChooser::kBlocks];
             d["reverse_query"] = runs[WalkChooser::kReverseQuery];
             d["first_visit"] = runs[WalkChooser::kFirstVisit];
+            d["per_ray_shared"] = runs[WalkChooser::kPerRayShared];
+            d["blocks_shared"] = runs[WalkChooser::kBlocksShared];
+            d["first_visit_shared"] = runs[WalkChooser::kFirstVisitShared];
             return d;
           },
           "scans over seen space walked by each clearing walk, as timed and chosen by the "
-          "integrator (per_ray, blocks, reverse_query, first_visit); the grid is the same "
-          "whichever ran")
+          "integrator (per_ray, blocks, reverse_query, first_visit; *_shared: on two "
+          "threads); the grid is the same whichever ran")
       .def(
           "integrate",
           [](ScanIntegrator& self, LogOddsGrid& grid,

@@ -1547,14 +1547,26 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
       walk_kind == ClearingWalk::kReverseQuery || (walk_kind == ClearingWalk::kAuto && use_blocks);
   // Over seen space kAuto's rule above is only the prior: the walks give the same grid, so the
   // chooser times them and runs the fastest for this kind of scan (walk_chooser.h).
+  // The walk is shared with a second thread where it is large enough (and, over seen space, where
+  // the chooser measured that it pays).
+  const bool may_share = threads >= 2 && steps >= thread_min_cells && !box.empty() &&
+                         box.max_y - box.min_y >= 2 * kBlock;
+  bool share = may_share;
   WalkTiming timing;
   if (walk_kind == ClearingWalk::kAuto && !box.empty() && !mark_sweep && !first_visits) {
-    const WalkChooser::Walk prior = use_blocks ? WalkChooser::kReverseQuery : WalkChooser::kPerRay;
+    const std::uint32_t available =
+        may_share ? WalkChooser::kAllWalks : WalkChooser::kOneThreadWalks;
+    const WalkChooser::Walk prior = use_blocks  ? WalkChooser::kReverseQuery
+                                    : may_share ? WalkChooser::kPerRayShared
+                                                : WalkChooser::kPerRay;
     const WalkChooser::Walk chosen =
-        s.chooser.choose(WalkChooser::contextOf(steps, box_cells), prior);
-    use_blocks = chosen == WalkChooser::kBlocks || chosen == WalkChooser::kReverseQuery;
-    try_reverse = chosen == WalkChooser::kReverseQuery;
-    first_visits = chosen == WalkChooser::kFirstVisit;
+        s.chooser.choose(WalkChooser::contextOf(steps, box_cells, available), prior, available);
+    const WalkChooser::Walk base = WalkChooser::oneThread(chosen);
+    use_blocks = base == WalkChooser::kBlocks || base == WalkChooser::kReverseQuery;
+    try_reverse = base == WalkChooser::kReverseQuery;
+    first_visits = base == WalkChooser::kFirstVisit;
+    // The reverse query runs on one thread; its fallback (the block walk) shares as before.
+    share = WalkChooser::shared(chosen) || (base == WalkChooser::kReverseQuery && may_share);
     timing.start(&s.chooser, steps);
   }
   if (!box.empty() && try_reverse) {
@@ -1603,7 +1615,7 @@ IntegrationStats integrateBeams(LogOddsGrid& grid, const std::vector<BeamUpdate>
   const RayWalkKind kind = use_blocks     ? RayWalkKind::kBlocks
                            : first_visits ? RayWalkKind::kFirstVisits
                                           : RayWalkKind::kPerRay;
-  if (threads >= 2 && steps >= thread_min_cells && box.max_y - box.min_y >= 2 * kBlock) {
+  if (share) {
     stats.cells_cleared = walkRaysInBands(sc, blocks, kind, box, kScanBands, &s);
   } else {
     stats.cells_cleared = walkRays(s.rays, sc, blocks, kind);

@@ -14,8 +14,9 @@ std::uint32_t octave(std::size_t n) {
 }
 }  // namespace
 
-std::uint32_t WalkChooser::contextOf(std::size_t ray_cells, std::size_t box_cells) {
-  return octave(ray_cells) | (octave(box_cells) << 8);
+std::uint32_t WalkChooser::contextOf(std::size_t ray_cells, std::size_t box_cells,
+                                     std::uint32_t available) {
+  return octave(ray_cells) | (octave(box_cells) << 8) | ((available & kAllWalks) << 16);
 }
 
 WalkChooser::Context& WalkChooser::contextFor(std::uint32_t key) {
@@ -34,19 +35,21 @@ WalkChooser::Context& WalkChooser::contextFor(std::uint32_t key) {
   return *oldest;
 }
 
-WalkChooser::Walk WalkChooser::fastest(const Context& c) {
+WalkChooser::Walk WalkChooser::fastest(const Context& c, std::uint32_t available) {
   int best = -1;
   for (int k = 0; k < kWalks; ++k) {
     const Measure& m = c.measures[k];
-    if (m.samples == 0) continue;
+    if (m.samples == 0 || !(available >> k & 1u)) continue;
     if (best < 0 || m.ns_per_cell < c.measures[best].ns_per_cell) best = k;
   }
   return static_cast<Walk>(std::max(best, 0));
 }
 
-WalkChooser::Walk WalkChooser::choose(std::uint32_t context, Walk prior) {
+WalkChooser::Walk WalkChooser::choose(std::uint32_t context, Walk prior, std::uint32_t available) {
   ++scans_;
+  available |= 1u << prior;
   Context& c = contextFor(context);
+  c.available = available;
   c.last_used = scans_;
   ++c.scans;
   Walk walk = prior;
@@ -56,14 +59,14 @@ WalkChooser::Walk WalkChooser::choose(std::uint32_t context, Walk prior) {
   if (c.measures[prior].samples >= 2) {
     int unmeasured = -1;
     for (int k = 0; k < kWalks && unmeasured < 0; ++k) {
-      if (c.measures[k].samples < 2) unmeasured = k;
+      if ((available >> k & 1u) && c.measures[k].samples < 2) unmeasured = k;
     }
     if (unmeasured >= 0) {
       walk = static_cast<Walk>(unmeasured);
     } else {
-      walk = fastest(c);
+      walk = fastest(c, available);
       for (int k = 0; k < kWalks; ++k) {
-        if (k != walk && c.scans >= c.measures[k].retry_at) {
+        if (k != walk && (available >> k & 1u) && c.scans >= c.measures[k].retry_at) {
           walk = static_cast<Walk>(k);
           trial = true;
           break;
@@ -85,7 +88,7 @@ void WalkChooser::report(double ns_per_cell) {
   // A scan below the clock's resolution still counts as fast.
   const double sample = std::isfinite(ns_per_cell) && ns_per_cell > 0.0 ? ns_per_cell : 1e-3;
   Measure& m = c.measures[pending_walk_];
-  const Walk before = fastest(c);
+  const Walk before = fastest(c, c.available);
   if (m.samples < 2 || pending_trial_) {
     m.ns_per_cell = sample;
   } else {
@@ -93,7 +96,7 @@ void WalkChooser::report(double ns_per_cell) {
   }
   ++m.samples;
   if (pending_trial_) {
-    if (fastest(c) == pending_walk_) {
+    if (fastest(c, c.available) == pending_walk_) {
       // It won: the walk it replaces is tried again soon, in case the trial was lucky.
       m.retry_scans = kFirstRetryScans;
       Measure& former = c.measures[before];

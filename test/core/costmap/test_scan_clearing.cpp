@@ -325,8 +325,9 @@ TEST(ScanClearing, AutoTakesTheBlockWalkOnlyForDenseRaysOverSeenSpace) {
 }
 
 TEST(ScanClearing, AutoTimesEachSteadyWalkAndStaysEqualToThePerRayWalk) {
-  // kAuto's chooser (walk_chooser.h) measures each of the three steady walks on its first scans
-  // of a kind, whatever the clock says; every scan must still equal the per-ray walk.
+  // kAuto's chooser (walk_chooser.h) measures each steady walk on its first scans of a kind
+  // (the four one-thread walks; with two threads allowed, the three shared ones too), whatever
+  // the clock says; every scan must still equal the per-ray walk.
   // A steady scene (no hits within 1.8 m, misses that saturate at once): the chooser's regime.
   const GridGeometry g(200, 170, 0.05, -4.3, -4.1);
   LogOddsConfig model;
@@ -335,21 +336,32 @@ TEST(ScanClearing, AutoTimesEachSteadyWalkAndStaysEqualToThePerRayWalk) {
   model.clamp_min = -2.1;
   model.clamp_max = 2.1;
   LogOddsGrid per_ray(g, model);
-  LogOddsGrid automatic(g, model);
-  IntegrationScratch scratch;
+  LogOddsGrid one_thread(g, model);
+  LogOddsGrid two_threads(g, model);
+  IntegrationScratch one_scratch;
+  IntegrationScratch two_scratch;
   std::mt19937 rng(5);
-  for (int s = 0; s < 24; ++s) {
+  for (int s = 0; s < 30; ++s) {
     std::vector<BeamUpdate> scan = randomScan(&rng, 0.013, -0.021, 3600, 2.5);
     for (BeamUpdate& b : scan) {
       if (std::hypot(b.end_x - b.start_x, b.end_y - b.start_y) < 1.8) b.mark = false;
     }
     const IntegrationStats a = integrateBeams(per_ray, scan, nullptr, ClearingWalk::kPerRay);
-    const IntegrationStats b = integrateBeams(automatic, scan, &scratch, ClearingWalk::kAuto);
+    const IntegrationStats b = integrateBeams(one_thread, scan, &one_scratch, ClearingWalk::kAuto);
+    const IntegrationStats c =
+        integrateBeams(two_threads, scan, &two_scratch, ClearingWalk::kAuto, 2, 0);
     expectSameStats(b, a);
-    for (std::size_t i = 0; i < g.cellCount(); ++i)
-      ASSERT_EQ(automatic.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+    expectSameStats(c, a);
+    for (std::size_t i = 0; i < g.cellCount(); ++i) {
+      ASSERT_EQ(one_thread.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+      ASSERT_EQ(two_threads.rawCells()[i], per_ray.rawCells()[i]) << "scan " << s << " cell " << i;
+    }
   }
-  for (int w = 0; w < WalkChooser::kWalks; ++w) EXPECT_GE(scratch.chooser.runs()[w], 2u) << w;
+  for (int w = 0; w < WalkChooser::kWalks; ++w) {
+    const bool shared = WalkChooser::shared(static_cast<WalkChooser::Walk>(w));
+    EXPECT_EQ(one_scratch.chooser.runs()[w] >= 2, !shared) << w;
+    EXPECT_GE(two_scratch.chooser.runs()[w], 2u) << w;
+  }
 }
 
 TEST(ScanClearing, TwoThreadsSplitTheRaysAtABlockRow) {

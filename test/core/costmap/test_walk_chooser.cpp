@@ -15,13 +15,16 @@ namespace {
 
 using Walk = WalkChooser::Walk;
 using Costs = std::array<double, WalkChooser::kWalks>;
+// Most tests use the four one-thread walks (their costs: per ray, blocks, reverse query, first
+// visit); the shared walks have a test of their own.
+constexpr std::uint32_t kOne = WalkChooser::kOneThreadWalks;
 
 // Runs n scans in `context` where walk k costs costs[k] ns per cell; returns the walks run.
 std::vector<Walk> run(WalkChooser* chooser, std::uint32_t context, Walk prior, const Costs& costs,
-                      int n) {
+                      int n, std::uint32_t available = kOne) {
   std::vector<Walk> walks;
   for (int i = 0; i < n; ++i) {
-    const Walk w = chooser->choose(context, prior);
+    const Walk w = chooser->choose(context, prior, available);
     chooser->report(costs[w]);
     walks.push_back(w);
   }
@@ -78,11 +81,11 @@ TEST(WalkChooser, OneSlowScanOfTheFastestWalkDoesNotDethroneIt) {
   WalkChooser chooser;
   run(&chooser, 4, WalkChooser::kPerRay, {1.0, 2.0, 0.5, 1.5}, 100);
   // One preempted scan of the running walk, 100x its time: capped at 3x, averaged in.
-  const Walk w = chooser.choose(4, WalkChooser::kPerRay);
+  const Walk w = chooser.choose(4, WalkChooser::kPerRay, kOne);
   ASSERT_EQ(w, WalkChooser::kReverseQuery);
   chooser.report(50.0);
   EXPECT_LT(chooser.figure(4, WalkChooser::kReverseQuery), 1.0);
-  EXPECT_EQ(chooser.choose(4, WalkChooser::kPerRay), WalkChooser::kReverseQuery);
+  EXPECT_EQ(chooser.choose(4, WalkChooser::kPerRay, kOne), WalkChooser::kReverseQuery);
   chooser.report(0.5);
 }
 
@@ -94,14 +97,15 @@ TEST(WalkChooser, ALuckyTrialIsUndoneSoon) {
   int scans = 0;
   for (;; ++scans) {
     ASSERT_LT(scans, 100);
-    const Walk w = chooser.choose(5, WalkChooser::kPerRay);
+    const Walk w = chooser.choose(5, WalkChooser::kPerRay, kOne);
     if (w == WalkChooser::kBlocks) {
       chooser.report(0.1);  // lucky
       break;
     }
     chooser.report(costs[w]);
   }
-  EXPECT_EQ(chooser.choose(5, WalkChooser::kPerRay), WalkChooser::kBlocks);  // believed, at first
+  EXPECT_EQ(chooser.choose(5, WalkChooser::kPerRay, kOne),
+            WalkChooser::kBlocks);  // believed, at first
   chooser.report(costs[WalkChooser::kBlocks]);
   // Its real figures come in (each capped at 3x its figure, so a few scans) and the reverse
   // query's old figure is faster again: back to it, the blocks tried again 16 scans later.
@@ -120,10 +124,10 @@ TEST(WalkChooser, KeepsContextsApart) {
   std::vector<Walk> sparse_walks;
   std::vector<Walk> dense_walks;
   for (int i = 0; i < 400; ++i) {
-    const Walk a = chooser.choose(sparse, WalkChooser::kPerRay);
+    const Walk a = chooser.choose(sparse, WalkChooser::kPerRay, kOne);
     chooser.report(a == WalkChooser::kPerRay ? 1.0 : 3.0);
     sparse_walks.push_back(a);
-    const Walk b = chooser.choose(dense, WalkChooser::kReverseQuery);
+    const Walk b = chooser.choose(dense, WalkChooser::kReverseQuery, kOne);
     chooser.report(b == WalkChooser::kReverseQuery ? 0.2 : 1.0);
     dense_walks.push_back(b);
   }
@@ -137,14 +141,36 @@ TEST(WalkChooser, KeepsContextsApart) {
   EXPECT_DOUBLE_EQ(chooser.figure(dense, WalkChooser::kReverseQuery), 0.2);
 }
 
+TEST(WalkChooser, ChoosesOnlyAvailableWalksAndTheSharedOnesWhereTheyPay) {
+  // A large map: two threads pay for the per-ray walk (0.6 against 1.0), not for the blocks.
+  const Costs large = {1.0, 2.0, 1.2, 1.5, 0.6, 2.5, 1.4};
+  WalkChooser chooser;
+  const std::vector<Walk> walks =
+      run(&chooser, 1, WalkChooser::kPerRayShared, large, 300, WalkChooser::kAllWalks);
+  EXPECT_GE(count(walks, WalkChooser::kPerRayShared, 100), 185);  // 6 walks retried: ~1 in 43
+  for (int k = 0; k < WalkChooser::kWalks; ++k) EXPECT_GE(chooser.runs()[k], 2u) << k;
+  // No second thread available (a small scan): never a shared walk, whatever it cost before.
+  const std::vector<Walk> small = run(&chooser, 2, WalkChooser::kPerRay, large, 300, kOne);
+  for (const Walk w : small) EXPECT_FALSE(WalkChooser::shared(w));
+  EXPECT_GE(count(small, WalkChooser::kPerRay, 100), 190);
+  // The walks' one-thread forms.
+  EXPECT_EQ(WalkChooser::oneThread(WalkChooser::kBlocksShared), WalkChooser::kBlocks);
+  EXPECT_EQ(WalkChooser::oneThread(WalkChooser::kFirstVisitShared), WalkChooser::kFirstVisit);
+  EXPECT_EQ(WalkChooser::oneThread(WalkChooser::kReverseQuery), WalkChooser::kReverseQuery);
+  // The context tells availability apart.
+  EXPECT_NE(WalkChooser::contextOf(1000, 1000, kOne), WalkChooser::contextOf(1000, 1000));
+}
+
 TEST(WalkChooser, ReportWithoutChoiceOrWithABadFigureIsHarmless) {
   WalkChooser chooser;
   chooser.report(1.0);  // nothing chosen: ignored
-  EXPECT_EQ(chooser.runs()[0] + chooser.runs()[1] + chooser.runs()[2] + chooser.runs()[3], 0u);
-  EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks), WalkChooser::kBlocks);
+  std::uint64_t runs = 0;
+  for (const std::uint64_t n : chooser.runs()) runs += n;
+  EXPECT_EQ(runs, 0u);
+  EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks, kOne), WalkChooser::kBlocks);
   chooser.report(0.0);  // below the clock's resolution: counts as fast, not as unmeasured
   EXPECT_GT(chooser.figure(9, WalkChooser::kBlocks), 0.0);
-  EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks), WalkChooser::kBlocks);
+  EXPECT_EQ(chooser.choose(9, WalkChooser::kBlocks, kOne), WalkChooser::kBlocks);
   chooser.report(-5.0);
   EXPECT_GT(chooser.figure(9, WalkChooser::kBlocks), 0.0);
 }

@@ -24,22 +24,44 @@ class WalkChooser {
  public:
   /// The walks it chooses between over seen space (ClearingWalk's per-ray, block, reverse-query
   /// and first-visit walks; the first-visit walk's loop measured faster than the per-ray one on
-  /// some steady sparse scans). Scans over unseen space keep kAuto's fixed rule (first-visit or
-  /// mark-sweep: there they win by far).
-  enum Walk : int { kPerRay = 0, kBlocks = 1, kReverseQuery = 2, kFirstVisit = 3 };
-  static constexpr int kWalks = 4;
+  /// some steady sparse scans), the *Shared ones on two threads (integrateBeams' bands: they pay
+  /// on large maps and cost ~0.1 ms where the box is small or the second core busy). Scans over
+  /// unseen space keep kAuto's fixed rule (first-visit or mark-sweep: there they win by far).
+  enum Walk : int {
+    kPerRay = 0,
+    kBlocks = 1,
+    kReverseQuery = 2,
+    kFirstVisit = 3,
+    kPerRayShared = 4,
+    kBlocksShared = 5,
+    kFirstVisitShared = 6
+  };
+  static constexpr int kWalks = 7;
+  static constexpr std::uint32_t kOneThreadWalks = 0xF;  ///< available without a second thread
+  static constexpr std::uint32_t kAllWalks = 0x7F;
+  /// Whether a walk runs on two threads, and the same walk on one.
+  static bool shared(Walk w) { return w >= kPerRayShared; }
+  static Walk oneThread(Walk w) {
+    return w == kPerRayShared       ? kPerRay
+           : w == kBlocksShared     ? kBlocks
+           : w == kFirstVisitShared ? kFirstVisit
+                                    : w;
+  }
   static constexpr int kContexts = 8;
   static constexpr int kFirstRetryScans = 16;
   static constexpr int kMaxRetryScans = 256;
   static constexpr double kAverageWeight = 0.25;
   static constexpr double kSpikeCap = 3.0;
 
-  /// The context of a scan: its rays' cells and the cells of their box, in octaves.
-  static std::uint32_t contextOf(std::size_t ray_cells, std::size_t box_cells);
+  /// The context of a scan: its rays' cells and the cells of their box, in octaves, and the walks
+  /// available to it (a bit per Walk).
+  static std::uint32_t contextOf(std::size_t ray_cells, std::size_t box_cells,
+                                 std::uint32_t available = kAllWalks);
 
-  /// The walk to run for a scan of this context; `prior` (kAuto's fixed rule) is tried first in
-  /// a context not seen before. Call report() after the walk.
-  Walk choose(std::uint32_t context, Walk prior);
+  /// The walk to run for a scan of this context, one of `available` (a bit per Walk); `prior`
+  /// (kAuto's fixed rule, available) is tried first in a context not seen before. Call report()
+  /// after the walk.
+  Walk choose(std::uint32_t context, Walk prior, std::uint32_t available = kAllWalks);
   /// The walk chose() returned took this long per ray cell (ns; any positive figure works).
   void report(double ns_per_cell);
 
@@ -58,12 +80,13 @@ class WalkChooser {
   struct Context {
     std::uint32_t key = 0;
     bool used = false;
-    std::uint64_t scans = 0;      ///< scans run in this context
-    std::uint64_t last_used = 0;  ///< the chooser's scan count when last chosen (LRU)
+    std::uint64_t scans = 0;              ///< scans run in this context
+    std::uint64_t last_used = 0;          ///< the chooser's scan count when last chosen (LRU)
+    std::uint32_t available = kAllWalks;  ///< the walks of its last choose()
     std::array<Measure, kWalks> measures;
   };
   Context& contextFor(std::uint32_t key);
-  static Walk fastest(const Context& c);
+  static Walk fastest(const Context& c, std::uint32_t available);
 
   std::array<Context, kContexts> contexts_{};
   std::array<std::uint64_t, kWalks> runs_{};
