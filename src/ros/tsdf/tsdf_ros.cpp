@@ -424,6 +424,7 @@ void TsdfRos::sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGri
   // The clearance only while someone listens (latched: a late subscriber gets the next): the
   // band's ESDF over the slice's cells (esdf_band.h), not a second distance mechanism. It sees
   // obstacles up to its cap outside the window, so its values there are the whole map's.
+  slice_distance_stats_ = EsdfBandStats{};  // nothing computed, nothing held, unless below
   if (slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
     EsdfBandConfig band;
     band.min_z_m = slice_.min_z_m;
