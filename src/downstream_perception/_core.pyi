@@ -589,9 +589,10 @@ class Tsdf:
         min_z_m: typing.SupportsFloat | typing.SupportsIndex = 0.05,
         max_z_m: typing.SupportsFloat | typing.SupportsIndex = 1.8,
         max_distance_m: typing.SupportsFloat | typing.SupportsIndex = 2.0,
+        grid: GridGeometry | None = None,
     ) -> dict:
         """
-        The height band's 2-D ESDF (what the nodelet publishes as ~slice_distance): a column is occupied when a voxel of the band (centres in [min_z_m, max_z_m], m) over it is occupied (D < 0, the ESDF's rule), free when it has only free and unknown ones. dict of grid (GridGeometry, the cells of Tsdf.slice over the map) and distance (float32 [y, x], m): (sqrt(k) - 1/2) * voxel size to the nearest occupied column (k in squared voxels), negative on occupied columns (to the nearest free one), clamped at max_distance_m, NaN on unknown columns; columns_occupied, columns_free. Read from the map now (no esdf_update needed). Raises ValueError on an inverted band or a cap outside [one voxel, 1e6] m.
+        The height band's 2-D ESDF (what the nodelet publishes as ~slice_distance): a column is occupied when a voxel of the band (centres in [min_z_m, max_z_m], m) over it is occupied (D < 0, the ESDF's rule), free when it has only free and unknown ones. dict of grid (GridGeometry: the argument, else the cells of Tsdf.slice over the map) and distance (float32 [y, x], m): (sqrt(k) - 1/2) * voxel size to the nearest occupied column (k in squared voxels), negative on occupied columns (to the nearest free one), clamped at max_distance_m, NaN on unknown columns; columns_occupied, columns_free (over the grid), columns_computed (the grid grown by the cap, within the blocks), voxels_in_band (known band voxels over the grid). grid: a window (Tsdf.slice_window) instead of the whole map; its values equal the whole map's there. Read from the map now (no esdf_update needed). Raises ValueError on an inverted band, a cap outside [one voxel, 1e6] m or a grid off the voxel lattice.
         """
     def esdf_distance(
         self, points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 3]"]
@@ -659,6 +660,16 @@ class Tsdf:
     ) -> numpy.typing.NDArray[numpy.int8]:
         """
         2-D slice over grid ([y, x] int8: 1 occupied, 0 free, -1 unknown): a cell is occupied when a voxel in the height band (m) over it is within occupied_distance_m of a surface or inside (default one voxel).
+        """
+    def slice_window(
+        self,
+        centre_x_m: typing.SupportsFloat | typing.SupportsIndex,
+        centre_y_m: typing.SupportsFloat | typing.SupportsIndex,
+        side_m: typing.SupportsFloat | typing.SupportsIndex = 0.0,
+        max_cells: typing.SupportsInt | typing.SupportsIndex = 4000000,
+    ) -> tuple:
+        """
+        The nodelet's slice grid (~slice_window_m, ~slice_max_cells): (GridGeometry, capped). A square of round(side_m / voxel) voxel columns whose middle column (n // 2) holds the centre (m), cut to the blocks' x-y extent; side_m 0: the whole extent. Larger than max_cells: cut to the floor(sqrt(max_cells)) square around the centre, capped True. An empty (0 x 0) grid when it misses every block. For Tsdf.slice and Tsdf.esdf_band_slice(grid=...). Raises ValueError on a side outside [0, 1e5] m, max_cells outside [1, 2^28] or a centre that is not finite.
         """
     def update_mesh(self) -> int:
         """

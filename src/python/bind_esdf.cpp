@@ -3,10 +3,12 @@
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -148,11 +150,13 @@ void bindEsdf(py::module& m) {
           "* voxel_size_m), distance (N,) float32 m, occupied (N,) int8.")
       .def(
           "esdf_band_slice",
-          [](const Tsdf& self, double min_z_m, double max_z_m, double max_distance_m) {
+          [](const Tsdf& self, double min_z_m, double max_z_m, double max_distance_m,
+             const std::optional<GridGeometry>& grid) {
             EsdfBandConfig c;
             c.min_z_m = min_z_m;
             c.max_z_m = max_z_m;
             c.max_distance_m = max_distance_m;
+            c.grid = grid;
             const std::string why = c.validate(self.map.voxelSize());
             if (!why.empty()) throw std::invalid_argument("esdf_band_slice: " + why);
             EsdfBandSlice band;
@@ -168,18 +172,25 @@ void bindEsdf(py::module& m) {
             out["distance"] = distance;
             out["columns_occupied"] = band.stats.columns_occupied;
             out["columns_free"] = band.stats.columns_free;
+            out["columns_computed"] = band.stats.columns_computed;
+            out["voxels_in_band"] = band.stats.voxels_in_band;
             return out;
           },
           py::arg("min_z_m") = 0.05, py::arg("max_z_m") = 1.8, py::arg("max_distance_m") = 2.0,
+          py::arg("grid") = py::none(),
           "The height band's 2-D ESDF (what the nodelet publishes as ~slice_distance): a column "
           "is occupied when a voxel of the band (centres in [min_z_m, max_z_m], m) over it is "
           "occupied (D < 0, the ESDF's rule), free when it has only free and unknown ones. dict "
-          "of grid (GridGeometry, the cells of Tsdf.slice over the map) and distance (float32 "
-          "[y, x], m): (sqrt(k) - 1/2) * voxel size to the nearest occupied column (k in "
-          "squared voxels), negative on occupied columns (to the nearest free one), clamped at "
-          "max_distance_m, NaN on unknown columns; columns_occupied, columns_free. Read from "
-          "the map now (no esdf_update needed). Raises ValueError on an inverted band or a cap "
-          "outside [one voxel, 1e6] m.")
+          "of grid (GridGeometry: the argument, else the cells of Tsdf.slice over the map) and "
+          "distance (float32 [y, x], m): (sqrt(k) - 1/2) * voxel size to the nearest occupied "
+          "column (k in squared voxels), negative on occupied columns (to the nearest free "
+          "one), clamped at max_distance_m, NaN on unknown columns; columns_occupied, "
+          "columns_free (over the "
+          "grid), columns_computed (the grid grown by the cap, within the blocks), "
+          "voxels_in_band (known band voxels over the grid). grid: a window (Tsdf.slice_window) "
+          "instead of the whole map; its values equal the whole map's there. Read from the map "
+          "now (no esdf_update needed). Raises ValueError on an inverted band, a cap outside "
+          "[one voxel, 1e6] m or a grid off the voxel lattice.")
       .def_property_readonly(
           "esdf_block_count", [](Tsdf& self) { return esdfOf(self).blockCount(); },
           "ESDF blocks (at most one per TSDF block)")

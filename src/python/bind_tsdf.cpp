@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -429,6 +430,30 @@ void bindTsdf(py::module& m) {
           "2-D slice over grid ([y, x] int8: 1 occupied, 0 free, -1 unknown): a cell is occupied "
           "when a voxel in the height band (m) over it is within occupied_distance_m of a "
           "surface or inside (default one voxel).")
+      .def(
+          "slice_window",
+          [](const Tsdf& self, double centre_x_m, double centre_y_m, double side_m,
+             std::int64_t max_cells) {
+            SliceWindow w;
+            w.centre_x_m = centre_x_m;
+            w.centre_y_m = centre_y_m;
+            w.side_m = side_m;
+            // A negative count would wrap to a huge size_t: refuse it as validate() refuses 0.
+            w.max_cells = static_cast<std::size_t>(std::max<std::int64_t>(0, max_cells));
+            bool capped = false;
+            const GridGeometry grid =
+                sliceWindowGeometry(blockColumns(self.map), self.map.voxelSize(), w, &capped);
+            return py::make_tuple(grid, capped);
+          },
+          py::arg("centre_x_m"), py::arg("centre_y_m"), py::arg("side_m") = 0.0,
+          py::arg("max_cells") = SliceWindow::kDefaultMaxCells,
+          "The nodelet's slice grid (~slice_window_m, ~slice_max_cells): (GridGeometry, capped). "
+          "A square of round(side_m / voxel) voxel columns whose middle column (n // 2) holds "
+          "the centre (m), cut to the blocks' x-y extent; side_m 0: the whole extent. Larger "
+          "than max_cells: cut to the floor(sqrt(max_cells)) square around the centre, capped "
+          "True. An empty (0 x 0) grid when it misses every block. For Tsdf.slice and "
+          "Tsdf.esdf_band_slice(grid=...). Raises ValueError on a side outside [0, 1e5] m, "
+          "max_cells outside [1, 2^28] or a centre that is not finite.")
       .def(
           "health",
           [](const Tsdf& self) {

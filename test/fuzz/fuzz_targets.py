@@ -1407,6 +1407,8 @@ def gen_esdf(rng: np.random.Generator) -> dict[str, Any]:
         "ops": ops,
         "query": sample_points(g),
         "band": (g.f(-1, 1), g.f(0.5, 3), g.f(0.05, 3)),  # min_z_m, max_z_m, max_distance_m
+        # Tsdf.slice_window: centre x, y (m), side (m), max_cells.
+        "window": (g.f(-2, 4), g.f(-2, 4), g.f(0, 4), g.i(1, 3000)),
     }
 
 
@@ -1467,9 +1469,28 @@ def call_esdf(a: dict[str, Any]) -> Any:
         if band_valid or not str(error):
             raise
         band = None
+    window = None
+    if band is not None:
+        cx, cy, side, cells = a["window"]
+        window_valid = (
+            math.isfinite(cx)
+            and math.isfinite(cy)
+            and math.isfinite(side)
+            and 0 <= side <= 1e5
+            and 1 <= cells <= 2**28
+        )
+        try:
+            grid, capped = tsdf.slice_window(cx, cy, side, cells)
+            if not window_valid:
+                problems.append(f"slice_window accepted {a['window']}")
+            window = (grid, capped, tsdf.esdf_band_slice(lo, hi, band_cap, grid))
+        except (ValueError, TypeError) as error:  # TypeError: a count beyond int64
+            if window_valid or not str(error):
+                raise
     return {
         "problems": problems,
         "band": band,
+        "window": window,
         "max": max_distance[-1],
         "distance": distance,
         "gradient": gradient,
@@ -1498,6 +1519,10 @@ def garbage_esdf(a: dict[str, Any], r: Any) -> str | None:
             int((known > 0).sum()),
         ):
             return "band slice column counts disagree with its signs"
+    if r["window"] is not None:
+        problem = garbage_window(a["window"][3], band, *r["window"])
+        if problem:
+            return problem
     v = r["voxel_distance"]
     if not (np.isfinite(v) & (np.abs(v) <= r["max"] + 1e-6)).all():
         return "a known ESDF voxel that is not finite or beyond the cap"
@@ -1511,6 +1536,27 @@ def garbage_esdf(a: dict[str, Any], r: Any) -> str | None:
     bad = ~np.isfinite(pts).all(axis=1) | (np.abs(pts).max(axis=1, initial=0) > 1e6)
     if (bad & known).any():
         return f"esdf_distance at {pts[bad & known][0].tolist()} is not NaN"
+    return None
+
+
+def garbage_window(
+    max_cells: int, whole: dict[str, Any], grid: Any, capped: bool, band: dict[str, Any]
+) -> str | None:
+    """A slice window within the cap and the whole map's grid, whose band ESDF is the whole
+    map's there, value for value."""
+    nx, ny = grid.size_x, grid.size_y
+    if nx * ny > max_cells:
+        return f"a slice window of {nx} x {ny} cells over the cap {max_cells}"
+    if nx * ny == 0:
+        return None if band["distance"].size == 0 else "values in an empty slice window"
+    g0 = whole["grid"]
+    x0 = round((grid.origin_x - g0.origin_x) / g0.resolution)
+    y0 = round((grid.origin_y - g0.origin_y) / g0.resolution)
+    if x0 < 0 or y0 < 0 or x0 + nx > g0.size_x or y0 + ny > g0.size_y:
+        return f"slice window {grid} beyond the map's {g0}"
+    expected = whole["distance"][y0 : y0 + ny, x0 : x0 + nx]
+    if not np.array_equal(band["distance"], expected, equal_nan=True):
+        return f"the band ESDF in window {grid} differs from the whole map's"
     return None
 
 

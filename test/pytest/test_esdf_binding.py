@@ -182,3 +182,48 @@ def test_band_slice_is_the_2d_esdf_of_the_bands_columns_and_the_rooms_clearance(
         tsdf.esdf_band_slice(1.0, 0.5)
     with pytest.raises(ValueError, match="max_distance_m"):
         tsdf.esdf_band_slice(0.05, 1.8, 0.0)
+
+
+def test_band_slice_in_a_window_is_the_whole_maps_there() -> None:
+    # Tsdf.slice_window (the nodelet's ~slice_window_m and ~slice_max_cells) and the band's ESDF
+    # over it: the transform runs over the window grown by the cap and is cropped, so inside the
+    # window every value equals the whole map's, also next to walls just outside it.
+    tsdf = make_tsdf()
+    integrate(tsdf, room_scene(), circle_poses(8))
+    whole = tsdf.esdf_band_slice(max_distance_m=1.0)
+    g0 = whole["grid"]
+    # 1 m at 5 cm: 20 columns; x = 1.63 is column 33 (floor(32.6 + 0.5)), index 10 of the
+    # window: columns 23..42, origin 22.5 voxels = 1.125 m; y = -0.41: column -8, -18..1.
+    grid, capped = tsdf.slice_window(1.63, -0.41, 1.0)
+    assert (grid.size_x, grid.size_y, capped) == (20, 20, False)
+    assert (grid.origin_x, grid.origin_y) == pytest.approx((1.125, -0.925), abs=1e-12)
+    for centre, side in (((1.63, -0.41), 1.0), ((-1.9, 1.9), 1.5), ((0.0, 0.0), 0.0)):
+        grid, _ = tsdf.slice_window(*centre, side)
+        band = tsdf.esdf_band_slice(max_distance_m=1.0, grid=grid)
+        got = band["grid"]
+        assert (got.size_x, got.size_y, got.origin_x, got.origin_y) == (
+            grid.size_x,
+            grid.size_y,
+            grid.origin_x,
+            grid.origin_y,
+        )
+        x0 = round((grid.origin_x - g0.origin_x) / VOXEL)
+        y0 = round((grid.origin_y - g0.origin_y) / VOXEL)
+        expected = whole["distance"][y0 : y0 + grid.size_y, x0 : x0 + grid.size_x]
+        np.testing.assert_array_equal(band["distance"], expected)
+        assert band["columns_occupied"] == int((expected < 0).sum())
+        assert band["columns_computed"] >= grid.size_x * grid.size_y
+        assert band["voxels_in_band"] > 0
+    # The cap: 100 cells cut the whole extent to the 10 x 10 square around the centre.
+    grid, capped = tsdf.slice_window(1.63, -0.41, 0.0, 100)
+    assert (grid.size_x, grid.size_y, capped) == (10, 10, True)
+    assert grid.origin_x == pytest.approx((33 - 5 - 0.5) * VOXEL, abs=1e-12)
+    # Missing every block: an empty grid, and an empty band slice over it.
+    grid, _ = tsdf.slice_window(50.0, 0.0, 1.0)
+    assert grid.size_x * grid.size_y == 0
+    assert tsdf.esdf_band_slice(grid=grid)["distance"].size == 0
+    for bad in ((0.0, 0.0, -1.0), (0.0, 0.0, float("nan")), (0.0, 0.0, 1.0, 0)):
+        with pytest.raises(ValueError, match="slice window"):
+            tsdf.slice_window(*bad)
+    with pytest.raises(ValueError, match="lattice|voxel column"):
+        tsdf.esdf_band_slice(grid=dp.GridGeometry(10, 10, VOXEL, 0.0, 0.0))

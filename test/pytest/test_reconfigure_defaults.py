@@ -150,6 +150,8 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         assert d[name] == pytest.approx(getattr(c, name)), name
     assert d["weighting"] == "constant"
     assert (d["slice_min_z_m"], d["slice_max_z_m"]) == (0.05, 1.8)
+    # The window's defaults: Tsdf.slice_window's (SliceWindow's in the core).
+    assert (d["slice_window_m"], d["slice_max_cells"]) == (0.0, 4000000)
     documented = yaml.safe_load((Path(__file__).parents[2] / "cfg" / "tsdf.yaml").read_text())
     for name, value in d.items():
         if name in documented:

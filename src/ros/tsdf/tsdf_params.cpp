@@ -47,6 +47,37 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   return TsdfConfig{};
 }
 
+namespace {
+
+/// ~slice_window_m and ~slice_max_cells, each checked on its own (SliceWindow::validate's
+/// limits): an invalid one is reported and its default kept, the other still applies.
+SliceWindow readSliceWindow(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
+  SliceWindow w;
+  double side_m = w.side_m;
+  pnh.param("slice_window_m", side_m, side_m);
+  if (!(std::isfinite(side_m) && side_m >= 0.0 && side_m <= SliceWindow::kMaxSideM)) {
+    errors->add("parameter ~slice_window_m = " + toText(side_m) + " must be in [0, " +
+                toText(SliceWindow::kMaxSideM) + "] m (0 = the whole map); using 0");
+    side_m = 0.0;
+  }
+  w.side_m = side_m;
+  // Read as a double: an int parameter overflows (or is refused by XmlRpc) long before a
+  // typo like 4e10 could be reported.
+  double max_cells = static_cast<double>(w.max_cells);
+  pnh.param("slice_max_cells", max_cells, max_cells);
+  if (!(max_cells >= 1.0 && max_cells <= static_cast<double>(GridGeometry::kMaxCells) &&
+        max_cells == std::floor(max_cells))) {
+    errors->add("parameter ~slice_max_cells = " + toText(max_cells) +
+                " must be a whole number in [1, " + std::to_string(GridGeometry::kMaxCells) +
+                "]; using " + std::to_string(SliceWindow::kDefaultMaxCells));
+    max_cells = static_cast<double>(SliceWindow::kDefaultMaxCells);
+  }
+  w.max_cells = static_cast<std::size_t>(max_cells);
+  return w;
+}
+
+}  // namespace
+
 TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   TsdfNodeSettings s;
   pnh.param("mesh_rate_hz", s.mesh_rate_hz, s.mesh_rate_hz);
@@ -74,6 +105,7 @@ TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog
                 " must be in [0, 100] m (0 = off); using 2");
     s.slice_distance_max_m = 2.0;
   }
+  s.slice_window = readSliceWindow(pnh, errors);
   pnh.param("esdf_max_distance_m", s.esdf_max_distance_m, s.esdf_max_distance_m);
   if (!(std::isfinite(s.esdf_max_distance_m) && s.esdf_max_distance_m >= 0.0)) {
     errors->add("parameter ~esdf_max_distance_m = " + toText(s.esdf_max_distance_m) +

@@ -46,6 +46,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   health_period_s_ = settings.health_period_s;
   slice_ = settings.slice;
   slice_distance_max_m_ = settings.slice_distance_max_m;
+  slice_window_ = settings.slice_window;
   map_ = std::make_unique<TsdfMap>(loadTsdfConfig(pnh_, &config_errors_));
   if (slice_distance_max_m_ > 0.0 && slice_distance_max_m_ < map_->voxelSize()) {
     // The band's ESDF needs a cap of a voxel at least (its nearest value is half a voxel).
@@ -126,10 +127,12 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   }
   TsdfConfig next;
   TsdfSliceConfig slice;
+  SliceWindow window;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     next = map_->config();
     slice = slice_;
+    window = slice_window_;
   }
   next.max_weight = cfg.max_weight;
   next.behind_surface_dropoff = cfg.behind_surface_dropoff;
@@ -149,6 +152,11 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next_slice.min_z_m = cfg.slice_min_z_m;
   next_slice.max_z_m = cfg.slice_max_z_m;
   const std::string slice_why = next_slice.validate();
+  SliceWindow next_window = window;
+  next_window.side_m = cfg.slice_window_m;
+  // An int in dynamic_reconfigure: negative values are refused by validate() as 0 is.
+  next_window.max_cells = static_cast<std::size_t>(std::max(0, cfg.slice_max_cells));
+  const std::string window_why = next_window.validate();
   TsdfConfig now;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -158,8 +166,15 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
                        next_slice.max_z_m != slice_.max_z_m;
       slice_ = next_slice;
     }
+    if (window_why.empty()) {
+      slice_changed_ = slice_changed_ || next_window.side_m != slice_window_.side_m ||
+                       next_window.max_cells != slice_window_.max_cells;
+      slice_window_.side_m = next_window.side_m;
+      slice_window_.max_cells = next_window.max_cells;
+    }
     now = map_->config();
     slice = slice_;
+    window = slice_window_;
   }
   if (!why.empty())
     config_errors_.add("live TSDF parameters refused (" + why + "); keeping the previous");
@@ -168,8 +183,16 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
     config_errors_.add("live slice band refused (" + slice_why + "); keeping [" +
                        toText(slice.min_z_m) + ", " + toText(slice.max_z_m) + "] m");
   }
-  ROS_INFO("tsdf: live settings: max weight %.1f, depth [%.2f, %.2f] m, slice [%.2f, %.2f] m",
-           now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m);
+  if (!window_why.empty()) {
+    config_errors_.add("live slice window refused (" + window_why + "); keeping " +
+                       toText(window.side_m) + " m, " + std::to_string(window.max_cells) +
+                       " cells");
+  }
+  ROS_INFO(
+      "tsdf: live settings: max weight %.1f, depth [%.2f, %.2f] m, slice [%.2f, %.2f] m, window "
+      "%.2f m (0: whole map), at most %zu cells",
+      now.max_weight, now.min_depth_m, now.max_depth_m, slice.min_z_m, slice.max_z_m, window.side_m,
+      window.max_cells);
 }
 
 bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::string* why) {
@@ -258,6 +281,7 @@ void TsdfRos::onDepth(const sensor_msgs::ImageConstPtr& msg) {
     const auto t0 = std::chrono::steady_clock::now();
     const TsdfIntegrationStats stats =
         integrator_.integrate(map_.get(), metres.data(), camera, T_world_camera);
+    if (stats.refused == nullptr) setSensorLocked(T_world_camera);
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -299,6 +323,7 @@ void TsdfRos::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     const auto t0 = std::chrono::steady_clock::now();
     const TsdfIntegrationStats stats =
         integratePoints(map_.get(), points, T_world_sensor.translation());
+    if (stats.refused == nullptr) setSensorLocked(T_world_sensor);
     account(
         stats,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -347,31 +372,71 @@ void TsdfRos::publishMesh(const ros::TimerEvent&) {
   diagnostics_.update();
 }
 
+void TsdfRos::setSensorLocked(const Eigen::Isometry3d& T_world_sensor) {
+  sensor_xy_ = T_world_sensor.translation().head<2>();
+  sensor_known_ = true;
+}
+
+GridGeometry TsdfRos::sliceGridLocked() {
+  const ColumnBox columns = blockColumns(*map_);
+  SliceWindow window = slice_window_;
+  const double s = map_->voxelSize();
+  // Blocks come from integrated frames, so the sensor is known whenever there are any; the
+  // blocks' middle only covers a map filled some other way.
+  const Eigen::Vector2d centre =
+      sensor_known_ ? sensor_xy_
+                    : Eigen::Vector2d(0.5 * static_cast<double>(columns.min_x + columns.max_x) * s,
+                                      0.5 * static_cast<double>(columns.min_y + columns.max_y) * s);
+  window.centre_x_m = centre.x();
+  window.centre_y_m = centre.y();
+  bool capped = false;
+  const GridGeometry grid = sliceWindowGeometry(columns, s, window, &capped);
+  if (capped) {
+    ++slices_capped_;
+    ROS_WARN_THROTTLE(10.0,
+                      "tsdf: the slice over %.0f x %.0f m exceeds ~slice_max_cells = %zu: cut to "
+                      "%d x %d cells around the sensor (set ~slice_window_m to bound it on "
+                      "purpose)",
+                      static_cast<double>(columns.width()) * s,
+                      static_cast<double>(columns.height()) * s, window.max_cells, grid.sizeX(),
+                      grid.sizeY());
+  }
+  return grid;
+}
+
 void TsdfRos::sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGridPtr* slice,
                           sensor_msgs::PointCloud2Ptr* distance) {
   slice_changed_ = false;
+  const auto t0 = std::chrono::steady_clock::now();
   GridGeometry grid;
   try {
-    grid = sliceGeometry(*map_);
+    grid = sliceGridLocked();
   } catch (const std::invalid_argument& error) {
-    // Blocks kilometres apart (a long drive at fine voxels): no grid can hold their extent.
+    // Kept as a guard: the window and its cap keep every grid within GridGeometry's limits.
     ++slices_refused_;
     ROS_WARN_THROTTLE(10.0, "tsdf: no slice this tick: %s", error.what());
     return;
   }
   std::vector<SliceCell> cells;
   if (grid.sizeX() > 0) cells = sliceTsdf(*map_, grid, slice_, &slice_stats_);
+  slice_cells_ = grid.cellCount();
   *slice = sliceGridMessage(cells, grid, slice_.min_z_m, header);
   // The clearance only while someone listens (latched: a late subscriber gets the next): the
-  // band's ESDF over the slice's cells (esdf_band.h), not a second distance mechanism.
+  // band's ESDF over the slice's cells (esdf_band.h), not a second distance mechanism. It sees
+  // obstacles up to its cap outside the window, so its values there are the whole map's.
+  slice_distance_stats_ = EsdfBandStats{};  // nothing computed, nothing held, unless below
   if (slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
     EsdfBandConfig band;
     band.min_z_m = slice_.min_z_m;
     band.max_z_m = slice_.max_z_m;
     band.max_distance_m = slice_distance_max_m_;
+    band.grid = grid;
     const EsdfBandSlice clearance = esdfBandSlice(*map_, band);
+    slice_distance_stats_ = clearance.stats;
     *distance = sliceDistanceCloud(clearance.distance_m, clearance.grid, band.min_z_m, header);
   }
+  slice_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void TsdfRos::returnFreeMemory() {
@@ -449,6 +514,24 @@ bool TsdfRos::clear(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   return true;
 }
 
+void TsdfRos::addSliceSizeLocked(diagnostic_updater::DiagnosticStatusWrapper& status) const {
+  status.add("slice window (m)",
+             slice_window_.side_m > 0.0 ? toText(slice_window_.side_m) : std::string("whole map"));
+  status.add("slice max cells", slice_window_.max_cells);
+  status.add("slices cut to slice_max_cells (total)", slices_capped_);
+  status.add("slice: cells", slice_cells_);
+  // The cells as SliceCell and as the message's data: a byte each.
+  status.add("slice: bytes", 2 * slice_cells_);
+  status.add("slice time last (ms)", slice_ms_);
+  if (!slice_distance_publisher_) return;
+  status.add("slice distance: columns computed (window and padding)",
+             slice_distance_stats_.columns_computed);
+  status.add("slice distance: bytes",
+             slice_distance_stats_.columns_computed * EsdfBandStats::kBytesPerComputedCell +
+                 slice_cells_ * sizeof(float));
+  status.add("slice distance: known band voxels read", slice_distance_stats_.voxels_in_band);
+}
+
 void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
   const std::size_t rejected = rejected_.report(status);
@@ -495,6 +578,7 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   }
   status.add("slice: free cells", slice_stats_.cells_free);
   status.add("slices refused (map extent beyond a grid)", slices_refused_);
+  addSliceSizeLocked(status);
   if (esdf_) esdf_->diagnose(status);
   status.add("mesh update time mean (ms)", mesh_ms_.mean());
   if (!last_health_.isZero()) {

@@ -109,6 +109,17 @@ class TsdfEsdfTest(unittest.TestCase):
         self.assertLessEqual(values, {-0.05, -diagonal, -0.025, 0.025, diagonal, 0.05})
         self.assertLessEqual({-0.025, 0.025, 0.05}, values)
 
+    def test_4_absurd_slice_windows_are_refused_and_the_defaults_kept(self) -> None:
+        # ~slice_window_m -3 and ~slice_max_cells 1e12: two config errors naming them; the
+        # whole map and the 4,000,000-cell cap apply.
+        self.assertTrue(wait_until(lambda: "config errors" in self.status, 10.0), self.status)
+        errors = [v for k, v in self.status.items() if k.startswith("config error ")]
+        self.assertTrue(any("~slice_window_m = -3" in e for e in errors), errors)
+        self.assertTrue(any("~slice_max_cells = 1e+12" in e for e in errors), errors)
+        self.assertEqual(self.status["slice window (m)"], "whole map")
+        self.assertEqual(self.status["slice max cells"], "4000000")
+        self.assertEqual(self.status["slices cut to slice_max_cells (total)"], "0")
+
 
 if __name__ == "__main__":
     rostest.rosrun("downstream_perception", "test_tsdf_esdf", TsdfEsdfTest)

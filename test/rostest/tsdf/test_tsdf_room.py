@@ -14,6 +14,7 @@ import os
 import tempfile
 import time
 import unittest
+from collections.abc import Callable
 
 import numpy as np
 import rospy
@@ -28,7 +29,7 @@ from std_srvs.srv import Empty
 
 from downstream_perception.ros.mesh_collector import MeshCollector
 from downstream_perception.ros.util import wait_until
-from downstream_perception.sim.depth_camera import room_scene
+from downstream_perception.sim.depth_camera import circle_poses, room_scene
 from downstream_perception.srv import SaveMap
 
 
@@ -292,6 +293,71 @@ class TsdfRoomTest(unittest.TestCase):
             wait_until(lambda: self.status.get("slice band (m)") == "0.05 .. 1.8", 10.0)
         )
 
+    def slice_where(self, ready: Callable[[OccupancyGrid], bool], what: str) -> OccupancyGrid:
+        """The latest slice once `ready` holds for it (10 s)."""
+        self.assertTrue(
+            wait_until(lambda: self.slice is not None and ready(self.slice), 10.0),
+            f"no slice with {what}",
+        )
+        assert self.slice is not None
+        return self.slice
+
+    def test_2e_window_and_cap_crop_the_slice(self) -> None:
+        # ~slice_window_m: a square of round(side / voxel) columns around the sensor's latest
+        # position (the last depth frame's camera), the column holding it at index n / 2, so the
+        # grid's origin is (column - n // 2 - 1/2) voxels. Both windows lie inside the room.
+        self.assertTrue(wait_until(lambda: self.done, 60.0), "the depth simulator never finished")
+        res = 0.04
+        eye = circle_poses(20)[-1][:2, 3]  # frame 19 of the simulator's 20
+        column = np.floor(eye / res + 0.5)
+        client = ReconfigureClient("/tsdf", timeout=10.0)
+        cut_key = "slices cut to slice_max_cells (total)"
+        cut_before = int(self.status.get(cut_key, -1))
+        self.assertGreaterEqual(cut_before, 0, self.status)
+
+        def check(grid: OccupancyGrid, n: int) -> None:
+            origin = (column - n // 2 - 0.5) * res
+            info = grid.info
+            self.assertEqual((info.width, info.height), (n, n))
+            self.assertAlmostEqual(info.resolution, res, places=6)
+            self.assertAlmostEqual(info.origin.position.x, origin[0], places=6)
+            self.assertAlmostEqual(info.origin.position.y, origin[1], places=6)
+            self.assertEqual(self.status.get("slice: cells"), str(n * n), self.status)
+
+        client.update_configuration({"slice_window_m": 1.0})  # 25 columns
+        windowed = self.slice_where(lambda g: g.info.width == 25, "a 1 m window")
+        self.assertTrue(wait_until(lambda: self.status.get("slice window (m)") == "1", 10.0))
+        self.assertTrue(wait_until(lambda: self.status.get("slice: cells") == "625", 10.0))
+        check(windowed, 25)
+        grid = np.asarray(windowed.data, dtype=np.int8)
+        self.assertGreater(int((grid >= 0).sum()), 300)  # the room's floor, observed
+        # Its clearance covers the same cells, one point per known cell.
+        stamp = windowed.header.stamp
+        self.assertTrue(wait_until(lambda: stamp in self.distances, 10.0))
+        points = np.array(
+            list(point_cloud2.read_points(self.distances[stamp], field_names=("x", "y")))
+        )
+        self.assertEqual(len(points), int((grid >= 0).sum()))
+        lo = (column - 12 - 0.5) * res
+        self.assertTrue(((points >= lo) & (points <= lo + 25 * res)).all())
+        # The cap: 400 cells cut the whole extent to 20 x 20 around the sensor, counted.
+        client.update_configuration({"slice_window_m": 0.0, "slice_max_cells": 400})
+        capped = self.slice_where(lambda g: g.info.width == 20, "the 400-cell cap")
+        self.assertTrue(wait_until(lambda: self.status.get("slice: cells") == "400", 10.0))
+        check(capped, 20)
+        self.assertGreater(int(self.status[cut_key]), cut_before)
+        # Absurd values are refused, counted, and the live ones kept.
+        errors = int(self.status.get("config errors", 0))
+        client.update_configuration({"slice_window_m": -1.0, "slice_max_cells": 0})
+        self.assertTrue(
+            wait_until(lambda: int(self.status.get("config errors", 0)) > errors, 10.0),
+            f"diagnostics: {self.status}",
+        )
+        self.assertEqual(self.status["slice max cells"], "400")
+        client.update_configuration({"slice_window_m": 0.0, "slice_max_cells": 4000000})
+        whole = self.slice_where(lambda g: g.info.width > 100, "the whole room")
+        self.assertGreater(whole.info.height, 100)
+
     def test_3_bad_frames_are_counted_and_survived(self) -> None:
         images = rospy.Publisher("/depth/image", Image, queue_size=50)
         infos = rospy.Publisher("/depth/camera_info", CameraInfo, queue_size=50)
@@ -333,15 +399,18 @@ class TsdfRoomTest(unittest.TestCase):
         self.assertTrue(wait_until(lambda: int(self.status.get("blocks", -1)) == 0, 5.0))
         self.assertTrue(wait_until(lambda: int(self.status.get("octomap: leaves", -1)) == 0, 5.0))
 
-    def test_5_a_map_too_wide_for_a_slice_grid_is_refused_and_survived(self) -> None:
+    def test_5_a_map_too_wide_for_a_slice_grid_is_cut_to_the_cap(self) -> None:
         # Two point clouds 700 m apart (a long drive at fine voxels): no slice grid holds that
         # extent at 4 cm (17,500^2 cells > 2^28). The mesh tick used to throw out of the timer
-        # and take the nodelet down; now it skips the slice, counts it and goes on.
+        # and take the nodelet down, then to skip the slice; now ~slice_max_cells (4,000,000)
+        # cuts it to the 2,000-column square around the sensor (then to the blocks), counted.
         import tf2_ros
         from geometry_msgs.msg import TransformStamped
 
-        key = "slices refused (map extent beyond a grid)"
-        self.assertTrue(wait_until(lambda: self.status.get(key) == "0", 10.0), self.status)
+        refused = "slices refused (map extent beyond a grid)"
+        key = "slices cut to slice_max_cells (total)"
+        self.assertTrue(wait_until(lambda: self.status.get(refused) == "0", 10.0), self.status)
+        cut_before = int(self.status[key])
         broadcaster = tf2_ros.StaticTransformBroadcaster()
         transforms = []
         for name, x in (("near_sensor", 0.0), ("far_sensor", 700.0)):
@@ -361,10 +430,18 @@ class TsdfRoomTest(unittest.TestCase):
             clouds.publish(point_cloud2.create_cloud_xyz32(header, wall))
             time.sleep(0.3)
         self.assertTrue(
-            wait_until(lambda: int(self.status.get(key, 0)) >= 1, 10.0),
+            wait_until(lambda: int(self.status.get(key, 0)) > cut_before, 10.0),
             f"diagnostics: {self.status}",
         )
         self.assertEqual(int(self.status["frames integrated"]), integrated + 2)
+        self.assertEqual(self.status[refused], "0")
+        # Around the far sensor (700, 700): columns from 17,500 - 1,000, up to the far blocks.
+        far = self.slice_where(lambda g: g.info.origin.position.x > 600.0, "the far window")
+        self.assertAlmostEqual(far.info.origin.position.x, (16500 - 0.5) * 0.04, places=6)
+        self.assertAlmostEqual(far.info.origin.position.y, (16500 - 0.5) * 0.04, places=6)
+        self.assertLess(far.info.width, 2000)
+        self.assertLess(far.info.height, 2000)
+        self.assertLessEqual(int(self.status["slice: cells"]), 4000000)
         # Still alive: a later cloud near the first is integrated and the diagnostics go on.
         clouds.publish(
             point_cloud2.create_cloud_xyz32(

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,9 +25,16 @@ struct EsdfBandConfig {
   double min_z_m = 0.05;        ///< band bottom (map frame, m): above the floor
   double max_z_m = 1.8;         ///< band top (m): the robot's height
   double max_distance_m = 2.0;  ///< clamp of the distances (m)
+  /// The cells to compute (sliceWindowGeometry's window); none: sliceGeometry(map), the blocks'
+  /// whole extent. It must lie on the voxel lattice (one cell per voxel column, voxel centres in
+  /// the middle). Obstacles up to max_distance_m outside it are still seen: the transform runs
+  /// over the grid grown by that much (within the blocks' extent) and is cropped, so the values
+  /// inside equal the whole map's.
+  std::optional<GridGeometry> grid;
   /// Empty if valid for voxels of voxel_size_m, else the reason: finite min_z_m < max_z_m;
   /// max_distance_m finite, at least one voxel (as the ESDF's: a smaller cap would clamp every
-  /// value, even the half voxel next to an obstacle) and at most kMaxDistanceM.
+  /// value, even the half voxel next to an obstacle) and at most kMaxDistanceM; a grid on the
+  /// lattice (or empty: no cells).
   std::string validate(double voxel_size_m) const;
   static constexpr double kMaxDistanceM = 1e6;  ///< distances are float32
 };
@@ -34,11 +42,18 @@ struct EsdfBandConfig {
 struct EsdfBandStats {
   std::size_t columns_occupied = 0;
   std::size_t columns_free = 0;
-  std::size_t voxels_in_band = 0;  ///< known voxels of the band read
+  std::size_t voxels_in_band = 0;  ///< known voxels of the band over the grid's columns
+  /// Columns the transform ran over: the grid grown by the cap (the padding), within the
+  /// blocks' extent. Its working memory is kBytesPerComputedCell per such column.
+  std::size_t columns_computed = 0;
+  /// Labels (1 byte), squared distances and the transform's scratch (4 + 4); the result's float
+  /// (4 bytes) per cell of the grid comes on top.
+  static constexpr std::size_t kBytesPerComputedCell = 9;
 };
 
 struct EsdfBandSlice {
-  /// sliceGeometry(map): one cell per voxel column, the same cells as sliceTsdf's.
+  /// config.grid, else sliceGeometry(map): one cell per voxel column, the same cells as
+  /// sliceTsdf's over that grid.
   GridGeometry grid;
   /// Row-major over `grid` (m): > 0 free (distance to the nearest occupied column), < 0
   /// occupied (to the nearest free column), NaN unknown; magnitudes clamped at max_distance_m.
@@ -46,9 +61,9 @@ struct EsdfBandSlice {
   EsdfBandStats stats;
 };
 
-/// The band's 2-D ESDF over sliceGeometry(map) (an empty grid for an empty map). Throws
-/// std::invalid_argument if config.validate(map.voxelSize()) fails or the map's x-y extent fits
-/// no GridGeometry (sliceGeometry's limits).
+/// The band's 2-D ESDF over config.grid, else over sliceGeometry(map) (an empty grid for an empty
+/// map). Throws std::invalid_argument if config.validate(map.voxelSize()) fails or, without a
+/// grid, the map's x-y extent fits no GridGeometry (sliceGeometry's limits).
 EsdfBandSlice esdfBandSlice(const TsdfMap& map, const EsdfBandConfig& config);
 
 }  // namespace downstream_perception

@@ -4,6 +4,8 @@
 // voxels in the band are free, the rest unknown.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,6 +43,58 @@ VoxelLayers bandLayers(double min_z_m, double max_z_m, double voxel_size_m);
 /// A grid over the x-y extent of the allocated blocks with one cell per voxel column (voxel
 /// centres in the middle of the cells). Invalid (0 x 0) for an empty map.
 GridGeometry sliceGeometry(const TsdfMap& map);
+
+/// The voxel columns (x, y lattice indices: column i holds the voxels whose centres have x = i *
+/// voxel) under the allocated blocks, in 64 bits (block keys times 16 need not fit an int).
+/// Empty for an empty map.
+struct ColumnBox {
+  std::int64_t min_x = 0;
+  std::int64_t min_y = 0;
+  std::int64_t max_x = -1;
+  std::int64_t max_y = -1;
+  bool empty() const { return min_x > max_x || min_y > max_y; }
+  std::int64_t width() const { return empty() ? 0 : max_x - min_x + 1; }
+  std::int64_t height() const { return empty() ? 0 : max_y - min_y + 1; }
+  ColumnBox intersected(const ColumnBox& o) const {
+    return {std::max(min_x, o.min_x), std::max(min_y, o.min_y), std::min(max_x, o.max_x),
+            std::min(max_y, o.max_y)};
+  }
+  /// The smallest box holding both (an empty one adds nothing).
+  ColumnBox hull(const ColumnBox& o) const {
+    if (o.empty()) return *this;
+    if (empty()) return o;
+    return {std::min(min_x, o.min_x), std::min(min_y, o.min_y), std::max(max_x, o.max_x),
+            std::max(max_y, o.max_y)};
+  }
+  ColumnBox grown(std::int64_t by) const {
+    return {min_x - by, min_y - by, max_x + by, max_y + by};
+  }
+};
+ColumnBox blockColumns(const TsdfMap& map);
+
+/// Where the slice is taken: a square window around the sensor, bounded in cells.
+struct SliceWindow {
+  double centre_x_m = 0.0;  ///< the sensor's latest position (map frame)
+  double centre_y_m = 0.0;
+  double side_m = 0.0;  ///< 0: the blocks' whole extent
+  /// Hard cap: a slice of more cells is cut to the square of floor(sqrt(max_cells)) columns
+  /// around the centre, so its memory is bounded whatever the map's extent and side_m.
+  std::size_t max_cells = kDefaultMaxCells;
+  static constexpr std::size_t kDefaultMaxCells = 4000000;  ///< 2,000^2: 100 m at 5 cm
+  /// Empty if valid, else the reason: side_m finite, in [0, kMaxSideM]; max_cells in [1,
+  /// GridGeometry::kMaxCells].
+  std::string validate() const;
+  static constexpr double kMaxSideM = 1e5;
+};
+
+/// The slice's grid for `window` over `columns` (blockColumns): the square of round(side /
+/// voxel) columns whose middle column (index n / 2) is the one holding the centre, so the grid
+/// moves in whole voxels and does not shimmer; intersected with `columns`; cut to the cap (see
+/// SliceWindow::max_cells) when larger. Cells as sliceGeometry's (one per voxel column, voxel
+/// centres in the middle). An invalid (0 x 0) grid when the window misses the blocks. *capped
+/// (optional) says whether the cap cut it. Throws std::invalid_argument on an invalid window.
+GridGeometry sliceWindowGeometry(const ColumnBox& columns, double voxel_size_m,
+                                 const SliceWindow& window, bool* capped = nullptr);
 
 /// The slice over `grid` (row-major, grid.index(x, y)); voxels are binned by their centre.
 std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,

@@ -25,14 +25,18 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors);
 std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c);
 
 /// The nodelet's own settings beside the map's TsdfConfig (~mesh_rate_hz, ~health_period_s, the
-/// slice, ~tf_queue_size). Each invalid value is added to `errors` and its default used.
+/// slice, its window, ~tf_queue_size). Each invalid value is added to `errors` and its default
+/// used.
 struct TsdfNodeSettings {
   double mesh_rate_hz = 1.0;
   double health_period_s = 10.0;  ///< 0: no periodic health line
   TsdfSliceConfig slice;
   double slice_distance_max_m = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
-  double esdf_max_distance_m = 1.0;   ///< the ESDF's clamp (m); 0: no ESDF
-  double esdf_slice_z_m = 1.0;        ///< height of ~esdf_slice (m, world_frame)
+  /// ~slice_window_m (side, m; 0: the blocks' whole extent) and ~slice_max_cells; the centre is
+  /// the sensor's, set per frame.
+  SliceWindow slice_window;
+  double esdf_max_distance_m = 1.0;  ///< the ESDF's clamp (m); 0: no ESDF
+  double esdf_slice_z_m = 1.0;       ///< height of ~esdf_slice (m, world_frame)
   int tf_queue_size = 10;
 };
 TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog* errors);

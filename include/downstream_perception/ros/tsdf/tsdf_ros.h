@@ -30,6 +30,7 @@
 #include "downstream_perception/SaveMap.h"
 #include "downstream_perception/TsdfNodeletConfig.h"
 #include "downstream_perception/core/running_stats.h"
+#include "downstream_perception/core/tsdf/esdf_band.h"
 #include "downstream_perception/core/tsdf/marching_cubes.h"
 #include "downstream_perception/core/tsdf/octree_worker.h"
 #include "downstream_perception/core/tsdf/tsdf_health.h"
@@ -66,10 +67,15 @@ class TsdfRos {
                       const std::string& what, int queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
-  /// Under mutex_: the slice and, while someone listens, its clearance (the band's ESDF); leaves
-  /// both null and counts slices_refused_ when the map's extent fits no grid.
+  /// Under mutex_: the slice and, while someone listens, its clearance (the band's ESDF), over
+  /// sliceGridLocked(); leaves both null and counts slices_refused_ when no grid can be made.
   void sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGridPtr* slice,
                    sensor_msgs::PointCloud2Ptr* distance);
+  /// Under mutex_: the slice's grid, the window of slice_window_ around the sensor's latest
+  /// position (the blocks' middle before any frame) cut to the blocks; counts slices_capped_.
+  GridGeometry sliceGridLocked();
+  /// Under mutex_: the position the next slice is centred on (frames integrated from `T`).
+  void setSensorLocked(const Eigen::Isometry3d& T_world_sensor);
   /// malloc_trim every kTrimPeriodS (on the mesh timer): freed memory goes back to the OS.
   void returnFreeMemory();
   static constexpr int kTrimPeriodS = 5;
@@ -80,6 +86,8 @@ class TsdfRos {
   bool saveMesh(SaveMap::Request& request, SaveMap::Response& response);
   bool clear(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// Under mutex_: the slice's window, cap, cuts, cells and bytes, and its clearance's.
+  void addSliceSizeLocked(diagnostic_updater::DiagnosticStatusWrapper& status) const;
   void reconfigure(TsdfNodeletConfig& config, std::uint32_t level);
   void account(const TsdfIntegrationStats& stats, double elapsed_ms);
 
@@ -114,6 +122,13 @@ class TsdfRos {
   bool slice_changed_ = false;         ///< the band moved: re-slice at the next mesh tick
   double slice_distance_max_m_ = 2.0;  ///< clearance cap of ~slice_distance (m); 0: off
   TsdfSliceStats slice_stats_;
+  SliceWindow slice_window_;  ///< side (~slice_window_m) and cap (~slice_max_cells); centre below
+  Eigen::Vector2d sensor_xy_ = Eigen::Vector2d::Zero();  ///< latest integrated frame's (world)
+  bool sensor_known_ = false;
+  // What the last slice held and cost, for diagnostics.
+  std::size_t slice_cells_ = 0;
+  EsdfBandStats slice_distance_stats_;
+  double slice_ms_ = 0.0;  ///< the slice and its clearance, last tick
   ros::ServiceServer save_service_;
   OutputDirectory output_directory_{
       defaultOutputDirectory()};  ///< ~output_dir: services write here
@@ -128,6 +143,7 @@ class TsdfRos {
   std::size_t pixels_invalid_ = 0;
   std::size_t blocks_refused_ = 0;
   std::size_t slices_refused_ = 0;  ///< mesh ticks whose map extent fits no slice grid
+  std::size_t slices_capped_ = 0;   ///< slices cut to ~slice_max_cells around the sensor
   std::size_t blocks_evicted_ = 0;
   std::size_t pixels_no_return_ignored_ = 0;  ///< +Inf pixels carving refused to use (total)
   TimingStats integrate_ms_;
