@@ -37,6 +37,8 @@ MARKER = re.compile(r"^<!-- parameters: (.*?) -->\n((?:\|.*\n?)+)", re.M)
 KEY_READ = re.compile(
     r"(?:\.|->|\b)(?:get|param|getParam|hasParam|searchParam|has|unsupported|take|search|p)(?:<[^>]*>)?\(\s*\"~?([A-Za-z_0-9]+)\""
 )
+# readParam(pnh, "key", &value, errors): the nodelets' typed reads (param_reader.h).
+READ_PARAM = re.compile(r"\breadParam\(\s*[A-Za-z_]\w*\s*,\s*\"~?([A-Za-z_0-9]+)\"")
 # Keys read elsewhere and declared to the reader: reader.known({"a", "b"}).
 KNOWN = re.compile(r"known\(\{([^}]*)\}\)")
 LITERAL = r"(-?[0-9][0-9.e+-]*|true|false|True|False|\"[^\"]*\"|std::string\(\"[^\"]*\"\))"
@@ -182,7 +184,7 @@ def same(doc: object, value: object) -> bool:
 def keys_read(path: Path) -> set[str]:
     text = path.read_text()
     declared = {k for group in KNOWN.findall(text) for k in re.findall(r'"(\w+)"', group)}
-    return set(KEY_READ.findall(text)) | declared
+    return set(KEY_READ.findall(text)) | set(READ_PARAM.findall(text)) | declared
 
 
 def test_tables_are_found_and_parsed() -> None:

@@ -112,6 +112,20 @@ std::string convertParam(const XmlRpc::XmlRpcValue& raw, std::string* value) {
   return wrongType(raw, "a string");
 }
 
+std::string convertParam(const XmlRpc::XmlRpcValue& raw, std::vector<std::string>* value) {
+  XmlRpc::XmlRpcValue v(raw);
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeArray) return wrongType(raw, "a list of strings");
+  std::vector<std::string> out;
+  for (int k = 0; k < v.size(); ++k) {
+    if (v[k].getType() != XmlRpc::XmlRpcValue::TypeString) {
+      return "has item " + std::to_string(k) + " " + describe(v[k]) + ", not a string";
+    }
+    out.push_back(static_cast<std::string>(v[k]));
+  }
+  *value = out;
+  return "";
+}
+
 std::vector<std::string> unknownKeys(const XmlRpc::XmlRpcValue& ns_value,
                                      const std::set<std::string>& known) {
   std::vector<std::string> unknown;

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "downstream_perception/ros/common/param_reader.h"
+
 namespace downstream_perception {
 
 std::string defaultOutputDirectory() {
@@ -19,7 +21,7 @@ std::string defaultOutputDirectory() {
 
 OutputDirectory readOutputDirectory(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   std::string directory = defaultOutputDirectory();
-  pnh.param("output_dir", directory, directory);
+  readParam(pnh, "output_dir", &directory, errors);
   if (directory.empty() || directory.front() != '/') {
     errors->add("parameter ~output_dir = '" + shortenForMessage(directory) +
                 "' must be an absolute directory; using " + defaultOutputDirectory());

@@ -8,6 +8,7 @@
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
+#include "downstream_perception/ros/common/param_reader.h"
 
 namespace downstream_perception {
 
@@ -18,11 +19,11 @@ HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   correction_ = CorrectionMonitor(correction_config_);
   health_.map_odom_pose_age_s = -1.0;  // no report yet
   RelayTopics topics;
-  pnh_.param("scan_topics", topics.scans, topics.scans);
-  pnh_.param("cloud_topics", topics.clouds, topics.clouds);
-  pnh_.param("track_topics", topics.tracks, topics.tracks);
-  pnh_.param("republish", topics.republish, topics.republish);
-  pnh_.param("tf_queue_size", topics.tf_queue_size, topics.tf_queue_size);
+  readParam(pnh_, "scan_topics", &topics.scans, &config_errors_);
+  readParam(pnh_, "cloud_topics", &topics.clouds, &config_errors_);
+  readParam(pnh_, "track_topics", &topics.tracks, &config_errors_);
+  readParam(pnh_, "republish", &topics.republish, &config_errors_);
+  readParam(pnh_, "tf_queue_size", &topics.tf_queue_size, &config_errors_);
   if (topics.tf_queue_size < 1 || topics.tf_queue_size > 10000) {
     config_errors_.add("parameter tf_queue_size = " + toText(topics.tf_queue_size) +
                        " must be in [1, 10000]; using 20");
@@ -46,17 +47,14 @@ HandoffRos::HandoffRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 void HandoffRos::loadParameters() {
-  pnh_.param("planning_frame", planning_frame_, planning_frame_);
-  pnh_.param("odom_frame", odom_frame_, odom_frame_);
-  pnh_.param("robot_base_frame", robot_base_frame_, robot_base_frame_);
-  pnh_.param("health_rate_hz", health_rate_hz_, health_rate_hz_);
-  pnh_.param("correction_window_s", correction_config_.window_s, correction_config_.window_s);
-  pnh_.param("correction_reset_drop_m", correction_config_.reset_drop_m,
-             correction_config_.reset_drop_m);
-  pnh_.param("max_correction_m", correction_config_.max_correction_m,
-             correction_config_.max_correction_m);
-  pnh_.param("correction_min_travel_m", correction_config_.min_travel_m,
-             correction_config_.min_travel_m);
+  readParam(pnh_, "planning_frame", &planning_frame_, &config_errors_);
+  readParam(pnh_, "odom_frame", &odom_frame_, &config_errors_);
+  readParam(pnh_, "robot_base_frame", &robot_base_frame_, &config_errors_);
+  readParam(pnh_, "health_rate_hz", &health_rate_hz_, &config_errors_);
+  readParam(pnh_, "correction_window_s", &correction_config_.window_s, &config_errors_);
+  readParam(pnh_, "correction_reset_drop_m", &correction_config_.reset_drop_m, &config_errors_);
+  readParam(pnh_, "max_correction_m", &correction_config_.max_correction_m, &config_errors_);
+  readParam(pnh_, "correction_min_travel_m", &correction_config_.min_travel_m, &config_errors_);
   if (!(std::isfinite(health_rate_hz_) && health_rate_hz_ > 0.0 && health_rate_hz_ <= 1000.0)) {
     config_errors_.add("parameter health_rate_hz = " + toText(health_rate_hz_) +
                        " must be in (0, 1000] Hz; using 2.0");

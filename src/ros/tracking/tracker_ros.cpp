@@ -9,6 +9,7 @@
 #include "downstream_perception/TrackedObjectArray.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/conversions.h"
+#include "downstream_perception/ros/common/param_reader.h"
 #include "downstream_perception/ros/common/tf_failure.h"
 #include "downstream_perception/ros/common/timing_diagnostics.h"
 
@@ -16,16 +17,17 @@ namespace downstream_perception {
 
 TrackerRos::TrackerRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
-  pnh_.param("tracking_frame", tracking_frame_, std::string("odom"));
-  std::string mode;
-  pnh_.param("mode", mode, std::string("metric"));
+  tracking_frame_ = "odom";
+  readParam(pnh_, "tracking_frame", &tracking_frame_, &config_errors_);
+  std::string mode = "metric";
+  readParam(pnh_, "mode", &mode, &config_errors_);
   if (mode != "metric" && mode != "image") {
     config_errors_.add("parameter ~mode = '" + mode + "' is invalid; using 'metric'");
     mode = "metric";
   }
   image_mode_ = mode == "image";
   int tf_queue_size = 20;
-  pnh_.param("tf_queue_size", tf_queue_size, 20);
+  readParam(pnh_, "tf_queue_size", &tf_queue_size, &config_errors_);
   if (tf_queue_size < 1 || tf_queue_size > 10000) {
     config_errors_.add("parameter ~tf_queue_size must be in [1, 10000]; using 20");
     tf_queue_size = 20;

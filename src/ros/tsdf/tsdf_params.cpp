@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstddef>
 
+#include "downstream_perception/ros/common/param_reader.h"
+
 namespace downstream_perception {
 
 std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c) {
@@ -18,27 +20,27 @@ std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, T
 
 TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   TsdfConfig c;
-  pnh.param("voxel_size_m", c.voxel_size_m, c.voxel_size_m);
-  pnh.param("truncation_voxels", c.truncation_voxels, c.truncation_voxels);
-  pnh.param("max_weight", c.max_weight, c.max_weight);
-  pnh.param("behind_surface_dropoff", c.behind_surface_dropoff, c.behind_surface_dropoff);
-  pnh.param("behind_surface_dropoff_start_voxels", c.behind_surface_dropoff_start_voxels,
-            c.behind_surface_dropoff_start_voxels);
-  pnh.param("interpolate_depth", c.interpolate_depth, c.interpolate_depth);
-  pnh.param("carve_free_space", c.carve_free_space, c.carve_free_space);
-  pnh.param("no_return_carve_min_valid_fraction", c.no_return_carve_min_valid_fraction,
-            c.no_return_carve_min_valid_fraction);
-  pnh.param("edge_guard_rad", c.edge_guard_rad, c.edge_guard_rad);
-  pnh.param("edge_guard_near_side_only", c.edge_guard_near_side_only, c.edge_guard_near_side_only);
-  pnh.param("edge_guard_grazing_voxels", c.edge_guard_grazing_voxels, c.edge_guard_grazing_voxels);
-  pnh.param("min_depth_m", c.min_depth_m, c.min_depth_m);
-  pnh.param("max_depth_m", c.max_depth_m, c.max_depth_m);
-  pnh.param("min_weight", c.min_weight, c.min_weight);
-  pnh.param("max_block_distance_m", c.max_block_distance_m, c.max_block_distance_m);
+  readParam(pnh, "voxel_size_m", &c.voxel_size_m, errors);
+  readParam(pnh, "truncation_voxels", &c.truncation_voxels, errors);
+  readParam(pnh, "max_weight", &c.max_weight, errors);
+  readParam(pnh, "behind_surface_dropoff", &c.behind_surface_dropoff, errors);
+  readParam(pnh, "behind_surface_dropoff_start_voxels", &c.behind_surface_dropoff_start_voxels,
+            errors);
+  readParam(pnh, "interpolate_depth", &c.interpolate_depth, errors);
+  readParam(pnh, "carve_free_space", &c.carve_free_space, errors);
+  readParam(pnh, "no_return_carve_min_valid_fraction", &c.no_return_carve_min_valid_fraction,
+            errors);
+  readParam(pnh, "edge_guard_rad", &c.edge_guard_rad, errors);
+  readParam(pnh, "edge_guard_near_side_only", &c.edge_guard_near_side_only, errors);
+  readParam(pnh, "edge_guard_grazing_voxels", &c.edge_guard_grazing_voxels, errors);
+  readParam(pnh, "min_depth_m", &c.min_depth_m, errors);
+  readParam(pnh, "max_depth_m", &c.max_depth_m, errors);
+  readParam(pnh, "min_weight", &c.min_weight, errors);
+  readParam(pnh, "max_block_distance_m", &c.max_block_distance_m, errors);
   int max_blocks = static_cast<int>(c.max_blocks);
-  pnh.param("max_blocks", max_blocks, max_blocks);
+  readParam(pnh, "max_blocks", &max_blocks, errors);
   std::string weighting = "constant";
-  pnh.param("weighting", weighting, weighting);
+  readParam(pnh, "weighting", &weighting, errors);
 
   std::string why = setNamedTsdfSettings(weighting, max_blocks, &c);
   if (why.empty()) why = c.validate();
@@ -54,7 +56,7 @@ namespace {
 SliceWindow readSliceWindow(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   SliceWindow w;
   double side_m = w.side_m;
-  pnh.param("slice_window_m", side_m, side_m);
+  readParam(pnh, "slice_window_m", &side_m, errors);
   if (!(std::isfinite(side_m) && side_m >= 0.0 && side_m <= SliceWindow::kMaxSideM)) {
     errors->add("parameter ~slice_window_m = " + toText(side_m) + " must be in [0, " +
                 toText(SliceWindow::kMaxSideM) + "] m (0 = the whole map); using 0");
@@ -64,7 +66,7 @@ SliceWindow readSliceWindow(const ros::NodeHandle& pnh, ConfigErrorLog* errors) 
   // Read as a double: an int parameter overflows (or is refused by XmlRpc) long before a
   // typo like 4e10 could be reported.
   double max_cells = static_cast<double>(w.max_cells);
-  pnh.param("slice_max_cells", max_cells, max_cells);
+  readParam(pnh, "slice_max_cells", &max_cells, errors);
   if (!(max_cells >= 1.0 && max_cells <= static_cast<double>(GridGeometry::kMaxCells) &&
         max_cells == std::floor(max_cells))) {
     errors->add("parameter ~slice_max_cells = " + toText(max_cells) +
@@ -80,25 +82,25 @@ SliceWindow readSliceWindow(const ros::NodeHandle& pnh, ConfigErrorLog* errors) 
 
 TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   TsdfNodeSettings s;
-  pnh.param("mesh_rate_hz", s.mesh_rate_hz, s.mesh_rate_hz);
+  readParam(pnh, "mesh_rate_hz", &s.mesh_rate_hz, errors);
   if (!(std::isfinite(s.mesh_rate_hz) && s.mesh_rate_hz > 0.0 && s.mesh_rate_hz <= 100.0)) {
     errors->add("parameter ~mesh_rate_hz = " + toText(s.mesh_rate_hz) +
                 " must be in (0, 100] Hz; using 1");
     s.mesh_rate_hz = 1.0;
   }
-  pnh.param("health_period_s", s.health_period_s, s.health_period_s);
+  readParam(pnh, "health_period_s", &s.health_period_s, errors);
   if (!(std::isfinite(s.health_period_s) && s.health_period_s >= 0.0)) {
     errors->add("parameter ~health_period_s must be >= 0 s (0 = off); using 10");
     s.health_period_s = 10.0;
   }
-  pnh.param("slice_min_z_m", s.slice.min_z_m, s.slice.min_z_m);
-  pnh.param("slice_max_z_m", s.slice.max_z_m, s.slice.max_z_m);
+  readParam(pnh, "slice_min_z_m", &s.slice.min_z_m, errors);
+  readParam(pnh, "slice_max_z_m", &s.slice.max_z_m, errors);
   const std::string slice_why = s.slice.validate();
   if (!slice_why.empty()) {
     errors->add("slice parameters invalid (" + slice_why + "); using 0.05 .. 1.8 m");
     s.slice = TsdfSliceConfig{};
   }
-  pnh.param("slice_distance_max_m", s.slice_distance_max_m, s.slice_distance_max_m);
+  readParam(pnh, "slice_distance_max_m", &s.slice_distance_max_m, errors);
   if (!(std::isfinite(s.slice_distance_max_m) && s.slice_distance_max_m >= 0.0 &&
         s.slice_distance_max_m <= 100.0)) {
     errors->add("parameter ~slice_distance_max_m = " + toText(s.slice_distance_max_m) +
@@ -106,18 +108,18 @@ TsdfNodeSettings readTsdfNodeSettings(const ros::NodeHandle& pnh, ConfigErrorLog
     s.slice_distance_max_m = 2.0;
   }
   s.slice_window = readSliceWindow(pnh, errors);
-  pnh.param("esdf_max_distance_m", s.esdf_max_distance_m, s.esdf_max_distance_m);
+  readParam(pnh, "esdf_max_distance_m", &s.esdf_max_distance_m, errors);
   if (!(std::isfinite(s.esdf_max_distance_m) && s.esdf_max_distance_m >= 0.0)) {
     errors->add("parameter ~esdf_max_distance_m = " + toText(s.esdf_max_distance_m) +
                 " must be finite and >= 0 m (0 = no ESDF); using 1");
     s.esdf_max_distance_m = 1.0;
   }
-  pnh.param("esdf_slice_z_m", s.esdf_slice_z_m, s.esdf_slice_z_m);
+  readParam(pnh, "esdf_slice_z_m", &s.esdf_slice_z_m, errors);
   if (!std::isfinite(s.esdf_slice_z_m)) {
     errors->add("parameter ~esdf_slice_z_m must be finite; using 1");
     s.esdf_slice_z_m = 1.0;
   }
-  pnh.param("tf_queue_size", s.tf_queue_size, s.tf_queue_size);
+  readParam(pnh, "tf_queue_size", &s.tf_queue_size, errors);
   if (s.tf_queue_size < 1 || s.tf_queue_size > 1000) {
     errors->add("parameter ~tf_queue_size must be in [1, 1000]; using 10");
     s.tf_queue_size = 10;
@@ -129,19 +131,19 @@ OctomapSettings readOctomapSettings(const ros::NodeHandle& pnh, const TsdfConfig
                                     ConfigErrorLog* errors) {
   OctomapSettings s;
   OctreeConfig& octree = s.octree;
-  pnh.param("octomap_resolution_m", octree.resolution_m, octree.resolution_m);
-  pnh.param("octomap_depth_stride_px", octree.depth_stride_px, octree.depth_stride_px);
+  readParam(pnh, "octomap_resolution_m", &octree.resolution_m, errors);
+  readParam(pnh, "octomap_depth_stride_px", &octree.depth_stride_px, errors);
   octree.max_range_m = map.max_depth_m;
   octree.max_distance_m = map.max_block_distance_m;  // the TSDF's bound
   double max_memory_mb = static_cast<double>(octree.max_memory_bytes) / (1 << 20);
-  pnh.param("octomap_max_memory_mb", max_memory_mb, max_memory_mb);
+  readParam(pnh, "octomap_max_memory_mb", &max_memory_mb, errors);
   if (!(std::isfinite(max_memory_mb) && max_memory_mb >= 1.0 && max_memory_mb <= 1e6)) {
     errors->add("parameter ~octomap_max_memory_mb = " + toText(max_memory_mb) +
                 " must be in [1, 1e6] MiB; using 256");
     max_memory_mb = 256.0;
   }
   octree.max_memory_bytes = static_cast<std::size_t>(max_memory_mb * (1 << 20));
-  pnh.param("octomap_queue_size", s.queue_size, s.queue_size);
+  readParam(pnh, "octomap_queue_size", &s.queue_size, errors);
   if (s.queue_size < 1 || s.queue_size > 100) {
     errors->add("parameter ~octomap_queue_size must be in [1, 100]; using 2");
     s.queue_size = 2;

@@ -15,6 +15,7 @@
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/conversions.h"
 #include "downstream_perception/ros/common/message_checks.h"
+#include "downstream_perception/ros/common/param_reader.h"
 #include "downstream_perception/ros/common/save_service.h"
 #include "downstream_perception/ros/common/tf_failure.h"
 #include "downstream_perception/ros/common/timing_diagnostics.h"
@@ -40,7 +41,8 @@ void TsdfRos::attachTfFilter(FilteredSubscription<M>* filter,
 TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh, pnh.getNamespace()) {
   config_errors_.setPrefix("tsdf");
-  pnh_.param("world_frame", world_frame_, std::string("odom"));
+  world_frame_ = "odom";
+  readParam(pnh_, "world_frame", &world_frame_, &config_errors_);
   output_directory_ = readOutputDirectory(pnh_, &config_errors_);
   const TsdfNodeSettings settings = readTsdfNodeSettings(pnh_, &config_errors_);
   health_period_s_ = settings.health_period_s;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "downstream_perception/ros/common/param_reader.h"
 
@@ -52,4 +53,27 @@ TEST(UnknownKeys, NamesEveryMemberNotDeclaredSorted) {
   EXPECT_EQ(unknown[0], "alpha");
   EXPECT_EQ(unknown[1], "raytrace_rnage");
   EXPECT_TRUE(unknownKeys(XmlRpc::XmlRpcValue(1), {}).empty());
+}
+
+TEST(ConvertParam, AListOfStringsIsReadWholeOrNotAtAll) {
+  XmlRpc::XmlRpcValue list;
+  list[0] = std::string("/a/scan");
+  list[1] = std::string("/b/scan");
+  std::vector<std::string> topics = {"default"};
+  EXPECT_EQ(convertParam(list, &topics), "");
+  EXPECT_EQ(topics, (std::vector<std::string>{"/a/scan", "/b/scan"}));
+  list[2] = 3;
+  std::vector<std::string> kept = {"default"};
+  EXPECT_EQ(convertParam(list, &kept), "has item 2 3 (int), not a string");
+  EXPECT_EQ(kept, std::vector<std::string>{"default"});
+  EXPECT_NE(convertParam(XmlRpc::XmlRpcValue(std::string("/a/scan")), &kept)
+                .find("not a list of strings"),
+            std::string::npos);
+}
+
+TEST(ConvertParam, DefaultsAreNamedAsTheyWouldBeWritten) {
+  EXPECT_EQ(defaultText(10.0), "10");
+  EXPECT_EQ(defaultText(true), "true");
+  EXPECT_EQ(defaultText(std::string("odom")), "'odom'");
+  EXPECT_EQ(defaultText(std::vector<std::string>{"/a", "/b"}), "['/a', '/b']");
 }

@@ -243,6 +243,9 @@ class HandoffInputsTest(unittest.TestCase):
         errors = " | ".join(kv.value for kv in status.values if kv.key.startswith("config"))
         for name in ("health_rate_hz", "reference_range_m", "max_smear_m", "window_s"):
             self.assertIn(name, errors + status.message)
+        # Values of the wrong type are named, not dropped without a word (roscpp's param()).
+        self.assertIn("~max_correction_m is '0.5' (string), not a number", errors)
+        self.assertIn("~track_topics has item 1 3 (int), not a string", errors)
 
     def has_status(self, name: str) -> bool:
         with self.lock:

@@ -120,6 +120,13 @@ class TsdfEsdfTest(unittest.TestCase):
         self.assertEqual(self.status["slice max cells"], "4000000")
         self.assertEqual(self.status["slices cut to slice_max_cells (total)"], "0")
 
+    def test_5_a_value_of_the_wrong_type_is_named_and_its_default_kept(self) -> None:
+        # ~health_period_s "often" (a string): roscpp's param() would drop it without a word.
+        self.assertTrue(wait_until(lambda: "config errors" in self.status, 10.0), self.status)
+        errors = [v for k, v in self.status.items() if k.startswith("config error ")]
+        expected = "~health_period_s is 'often' (string), not a number; using the default 10"
+        self.assertTrue(any(expected in e for e in errors), errors)
+
 
 if __name__ == "__main__":
     rostest.rosrun("downstream_perception", "test_tsdf_esdf", TsdfEsdfTest)

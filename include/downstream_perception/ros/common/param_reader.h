@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "downstream_perception/ros/common/config_errors.h"
+
 namespace downstream_perception {
 
 /// How a raw parameter value converts to T. ROS-free of the master: unit-tested on XmlRpcValues.
@@ -24,6 +26,47 @@ std::string convertParam(const XmlRpc::XmlRpcValue& raw, double* value);
 std::string convertParam(const XmlRpc::XmlRpcValue& raw, int* value);
 std::string convertParam(const XmlRpc::XmlRpcValue& raw, bool* value);
 std::string convertParam(const XmlRpc::XmlRpcValue& raw, std::string* value);
+std::string convertParam(const XmlRpc::XmlRpcValue& raw, std::vector<std::string>* value);
+
+/// A default as readParam's error names it (lists joined, strings quoted).
+inline std::string defaultText(const std::string& v) {
+  return "'" + v + "'";
+}
+inline std::string defaultText(const std::vector<std::string>& v) {
+  std::string text = "[";
+  for (std::size_t k = 0; k < v.size(); ++k) text += (k ? ", '" : "'") + v[k] + "'";
+  return text + "]";
+}
+inline std::string defaultText(bool v) {
+  return v ? "true" : "false";
+}
+template <class T>
+std::string defaultText(const T& v) {
+  return toText(v);
+}
+
+/// nh.param(key, *value, *value) without its silent fallback: a value of the wrong type leaves
+/// *value (the default) and returns why ("" when the key is unset or was read). For nodelets that
+/// read their own keys one by one (TSDF, tracker, handoff); layers use ParamReader.
+template <class T>
+std::string readParam(const ros::NodeHandle& nh, const std::string& key, T* value) {
+  XmlRpc::XmlRpcValue raw;
+  if (!nh.getParam(key, raw)) return "";
+  T read{};
+  const std::string why = convertParam(raw, &read);
+  if (why.empty()) *value = read;
+  return why;
+}
+
+/// readParam() whose wrong type is a config error: "parameter ~key is ..., not ...; using the
+/// default <value>" (logged, and counted in the component's diagnostics).
+template <class T>
+void readParam(const ros::NodeHandle& nh, const std::string& key, T* value,
+               ConfigErrorLog* errors) {
+  const std::string why = readParam(nh, key, value);
+  if (why.empty()) return;
+  errors->add("parameter ~" + key + " " + why + "; using the default " + defaultText(*value));
+}
 
 /// The member names of `ns_value` (a struct) that are not in `known`, sorted.
 std::vector<std::string> unknownKeys(const XmlRpc::XmlRpcValue& ns_value,
