@@ -17,6 +17,19 @@
 namespace downstream_perception {
 
 namespace {
+
+// The scans over seen space each clearing walk ran (kAuto's timed choice, walk_chooser.h), the
+// shared (two-thread) walks summed: "per ray / blocks / reverse query / first visit / shared".
+// Read under grid_mutex_, which integrate() holds.
+std::string walkRunsText(const ScanIntegrator& integrator) {
+  const auto& runs = integrator.walkChooser().runs();
+  const auto shared = runs[WalkChooser::kPerRayShared] + runs[WalkChooser::kBlocksShared] +
+                      runs[WalkChooser::kFirstVisitShared];
+  return std::to_string(runs[WalkChooser::kPerRay]) + " / " +
+         std::to_string(runs[WalkChooser::kBlocks]) + " / " +
+         std::to_string(runs[WalkChooser::kReverseQuery]) + " / " +
+         std::to_string(runs[WalkChooser::kFirstVisit]) + " / " + std::to_string(shared);
+}
 // Decay runs at most this often: each pass scans the evidence box once.
 constexpr double kMinDecayPeriodS = 0.1;
 // Tracked-object clearing reaches this far behind the older of (the track's stamp, the previous
@@ -654,6 +667,13 @@ void LogOddsObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
     status.add(p + "beams no return (total)", h.total.beams_no_return);
     status.add(p + "points outside height band (total)", h.total.points_outside_height);
     status.add(p + "points merged into a cell's beam (total)", h.total.points_merged);
+    std::string walks;
+    {
+      std::lock_guard<std::mutex> lock(grid_mutex_);
+      walks = walkRunsText(source->integrator());
+    }
+    status.add(p + "clearing walks run (per ray / blocks / reverse query / first visit / shared)",
+               walks);
     status.add(p + "current", current);
     waiting_total += addTfWaits(status, p, source->waitingForTf());
   }

@@ -99,6 +99,13 @@ class CostmapAisleTest(unittest.TestCase):
         self.assertGreater(
             float(self.watch.layer_status["scan: clear:mark ratio (all messages)"]), 5.0
         )
+        # The timed choice of clearing walk (walk_chooser.h): over the aisle, seen after the
+        # first scans, every scan runs one of them, and each walk is measured at least twice.
+        key = "scan: clearing walks run (per ray / blocks / reverse query / first visit / shared)"
+        runs = [int(n) for n in self.watch.layer_status[key].split(" / ")]
+        self.assertEqual(len(runs), 5, runs)
+        self.assertGreaterEqual(sum(runs), 10, runs)
+        self.assertTrue(all(n >= 2 for n in runs[:4]), runs)
 
 
 if __name__ == "__main__":
