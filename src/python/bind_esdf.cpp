@@ -151,8 +151,9 @@ void bindEsdf(py::module& m) {
       .def(
           "esdf_band_slice",
           [](const Tsdf& self, double min_z_m, double max_z_m, double max_distance_m,
-             const std::optional<GridGeometry>& grid) {
+             const std::optional<GridGeometry>& grid, std::size_t max_computed_columns) {
             EsdfBandConfig c;
+            c.max_computed_columns = max_computed_columns;
             c.min_z_m = min_z_m;
             c.max_z_m = max_z_m;
             c.max_distance_m = max_distance_m;
@@ -174,10 +175,12 @@ void bindEsdf(py::module& m) {
             out["columns_free"] = band.stats.columns_free;
             out["columns_computed"] = band.stats.columns_computed;
             out["voxels_in_band"] = band.stats.voxels_in_band;
+            out["padding_voxels"] = band.stats.padding_voxels;
+            out["padding_cut"] = band.stats.padding_cut;
             return out;
           },
           py::arg("min_z_m") = 0.05, py::arg("max_z_m") = 1.8, py::arg("max_distance_m") = 2.0,
-          py::arg("grid") = py::none(),
+          py::arg("grid") = py::none(), py::arg("max_computed_columns") = 0,
           "The height band's 2-D ESDF (what the nodelet publishes as ~slice_distance): a column "
           "is occupied when a voxel of the band (centres in [min_z_m, max_z_m], m) over it is "
           "occupied (D < 0, the ESDF's rule), free when it has only free and unknown ones. dict "
@@ -187,8 +190,11 @@ void bindEsdf(py::module& m) {
           "one), clamped at max_distance_m, NaN on unknown columns; columns_occupied, "
           "columns_free (over the "
           "grid), columns_computed (the grid grown by the cap, within the blocks), "
-          "voxels_in_band (known band voxels over the grid). grid: a window (Tsdf.slice_window) "
-          "instead of the whole map; its values equal the whole map's there. Read from the map "
+          "voxels_in_band (known band voxels over the grid), padding_voxels (columns computed "
+          "beyond the grid on each side) and padding_cut. grid: a window (Tsdf.slice_window) "
+          "instead of the whole map; its values equal the whole map's there unless "
+          "max_computed_columns (0: no bound) narrowed the padding (padding_cut: a cell nearer "
+          "the edge than the cap may then read farther). Read from the map "
           "now (no esdf_update needed). Raises ValueError on an inverted band, a cap outside "
           "[one voxel, 1e6] m or a grid off the voxel lattice.")
       .def_property_readonly(

@@ -227,3 +227,32 @@ def test_band_slice_in_a_window_is_the_whole_maps_there() -> None:
             tsdf.slice_window(*bad)
     with pytest.raises(ValueError, match="lattice|voxel column"):
         tsdf.esdf_band_slice(grid=dp.GridGeometry(10, 10, VOXEL, 0.0, 0.0))
+
+
+def test_band_slice_padding_is_bounded_by_max_computed_columns() -> None:
+    # A 1 m window (20 x 20 columns) with a 1 m cap pads ceil(1 / 0.05 + 1/2) = 21 columns on
+    # each side; at most 30 x 30 columns computed, the padding narrows to 5 and obstacles beyond
+    # it are missed: a value may only grow, and equals the whole map's wherever the nearest
+    # column of the other kind lies within the computed box.
+    tsdf = make_tsdf()
+    integrate(tsdf, room_scene(), circle_poses(8))
+    whole = tsdf.esdf_band_slice(max_distance_m=1.0)
+    g0 = whole["grid"]
+    grid, _ = tsdf.slice_window(1.63, -0.41, 1.0)
+    free = tsdf.esdf_band_slice(max_distance_m=1.0, grid=grid)
+    assert (free["padding_voxels"], free["padding_cut"]) == (21, False)
+    band = tsdf.esdf_band_slice(max_distance_m=1.0, grid=grid, max_computed_columns=30 * 30)
+    assert (band["padding_voxels"], band["padding_cut"]) == (5, True)
+    assert band["columns_computed"] <= 30 * 30
+    x0 = round((grid.origin_x - g0.origin_x) / VOXEL)
+    y0 = round((grid.origin_y - g0.origin_y) / VOXEL)
+    expected = whole["distance"][y0 : y0 + grid.size_y, x0 : x0 + grid.size_x]
+    got = band["distance"]
+    known = ~np.isnan(expected)
+    assert known.sum() > 100
+    assert np.all(np.abs(got[known]) >= np.abs(expected[known]))
+    yy, xx = np.mgrid[0 : grid.size_y, 0 : grid.size_x]
+    edge = np.minimum(np.minimum(xx, yy), np.minimum(grid.size_x - 1 - xx, grid.size_y - 1 - yy))
+    inside = known & (np.abs(expected) / VOXEL + 0.5 <= edge + 5)
+    assert inside.sum() > 10
+    np.testing.assert_array_equal(got[inside], expected[inside])

@@ -111,7 +111,27 @@ EsdfBandSlice esdfBandSlice(const TsdfMap& map, const EsdfBandConfig& config) {
   // equals the whole map's. Beyond the blocks there are no seeds, so the growth stops there.
   const double s = map.voxelSize();
   const double radius = std::ceil(config.max_distance_m / s + 0.5);
-  const auto reach = static_cast<std::int64_t>(std::min(radius, double{kMaxRadiusVoxels}));
+  std::int64_t reach = static_cast<std::int64_t>(std::min(radius, double{kMaxRadiusVoxels}));
+  const auto fits = [&](std::int64_t r) {
+    return (static_cast<double>(nx) + 2.0 * r) * (static_cast<double>(ny) + 2.0 * r) <=
+           static_cast<double>(config.max_computed_columns);
+  };
+  if (config.max_computed_columns > 0 && !fits(reach)) {
+    // The widest padding that fits (none if the grid alone fills the bound).
+    std::int64_t lo = 0;
+    std::int64_t hi = reach;
+    while (lo < hi) {
+      const std::int64_t mid = (lo + hi + 1) / 2;
+      if (fits(mid)) {
+        lo = mid;
+      } else {
+        hi = mid - 1;
+      }
+    }
+    reach = lo;
+    out.stats.padding_cut = true;
+  }
+  out.stats.padding_voxels = static_cast<std::size_t>(reach);
   const ColumnBox target = gridColumns(out.grid, s);
   const ColumnBox box = target.grown(reach).intersected(blockColumns(map).hull(target));
   const int px = static_cast<int>(box.width());

@@ -25,6 +25,9 @@ void TsdfRos::addSliceSizeLocked(diagnostic_updater::DiagnosticStatusWrapper& st
              slice_distance_stats_.columns_computed * EsdfBandStats::kBytesPerComputedCell +
                  slice_cells_ * sizeof(float));
   status.add("slice distance: known band voxels read", slice_distance_stats_.voxels_in_band);
+  status.add("slice distance: padding (voxels)", slice_distance_stats_.padding_voxels);
+  status.add("slice distance: padding narrowed to 2 x slice_max_cells (total)",
+             clearance_padding_cuts_);
 }
 
 void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

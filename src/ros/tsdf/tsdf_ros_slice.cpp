@@ -61,7 +61,9 @@ void TsdfRos::sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGri
   *slice = sliceGridMessage(cells, grid, slice_.min_z_m, header);
   // The clearance only while someone listens (latched: a late subscriber gets the next): the
   // band's ESDF over the slice's cells (esdf_band.h), not a second distance mechanism. It sees
-  // obstacles up to its cap outside the window, so its values there are the whole map's.
+  // obstacles up to its cap outside the window, so its values there are the whole map's, unless
+  // that padding would pass twice ~slice_max_cells (a long cap at fine voxels): then it is
+  // narrowed, and counted.
   slice_distance_stats_ = EsdfBandStats{};  // nothing computed, nothing held, unless below
   if (slice_distance_publisher_ && slice_distance_publisher_.getNumSubscribers() > 0) {
     EsdfBandConfig band;
@@ -69,8 +71,18 @@ void TsdfRos::sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGri
     band.max_z_m = slice_.max_z_m;
     band.max_distance_m = slice_distance_max_m_;
     band.grid = grid;
+    band.max_computed_columns = kClearanceColumnsPerSliceCell * slice_window_.max_cells;
     const EsdfBandSlice clearance = esdfBandSlice(*map_, band);
     slice_distance_stats_ = clearance.stats;
+    if (clearance.stats.padding_cut) {
+      ++clearance_padding_cuts_;
+      ROS_WARN_THROTTLE(10.0,
+                        "tsdf: the clearance's padding (~slice_distance_max_m %.2f m beyond the "
+                        "window) was narrowed to %zu voxels to stay within %zu columns: near the "
+                        "window's edge it may read farther than the map's",
+                        slice_distance_max_m_, clearance.stats.padding_voxels,
+                        band.max_computed_columns);
+    }
     *distance = sliceDistanceCloud(clearance.distance_m, clearance.grid, band.min_z_m, header);
   }
   slice_ms_ =

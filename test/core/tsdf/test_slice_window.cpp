@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -240,6 +241,66 @@ TEST(SliceWindow, BandEsdfInAWindowEqualsTheWholeMapsInsideIt) {
     // The whole map read every known band voxel; a window reads fewer.
     EXPECT_GT(whole.stats.voxels_in_band, 0u);
   }
+}
+
+TEST(SliceWindow, BandEsdfPaddingIsBoundedByMaxComputedColumns) {
+  // A 1 m window (20 x 20 columns) with a 2 m cap pads 41 columns on each side (102^2 computed).
+  // Bounded at 40 x 40 columns the padding narrows to the widest that fits, 10 columns: cells at
+  // least 41 - 10 columns inside the window's edge still equal the whole map's.
+  RoomScene scene;
+  scene.offset = Eigen::Vector3d(0.037, 0.061, 0.023);
+  const TsdfMap map = filledRoom(0.05, scene);
+  EsdfBandConfig c;
+  c.max_distance_m = 2.0;
+  const EsdfBandSlice whole = esdfBandSlice(map, c);
+  SliceWindow w;
+  w.centre_x_m = 0.3;
+  w.centre_y_m = -0.2;
+  w.side_m = 1.0;
+  c.grid = sliceWindowGeometry(blockColumns(map), map.voxelSize(), w);
+  ASSERT_EQ(c.grid->sizeX(), 20);
+  ASSERT_EQ(c.grid->sizeY(), 20);
+  const EsdfBandSlice unbounded = esdfBandSlice(map, c);
+  EXPECT_FALSE(unbounded.stats.padding_cut);
+  EXPECT_EQ(unbounded.stats.padding_voxels, 41u);  // ceil(2 / 0.05 + 1/2)
+  c.max_computed_columns = 40 * 40;
+  const EsdfBandSlice band = esdfBandSlice(map, c);
+  EXPECT_TRUE(band.stats.padding_cut);
+  EXPECT_EQ(band.stats.padding_voxels, 10u);  // 20 + 2 * 10 = 40; 11 would make 42^2
+  EXPECT_LE(band.stats.columns_computed, c.max_computed_columns);
+  const GridGeometry& g = band.grid;
+  const CellIndex o = whole.grid.worldToCellUnbounded(g.originX() + 0.5 * g.resolution(),
+                                                      g.originY() + 0.5 * g.resolution());
+  // The window lies 41 - 10 = 31 columns deep at most; no cell is that far from the edge, so
+  // check the rule on the cells it covers: equal wherever the whole map's nearest obstacle lies
+  // within the computed box, never nearer than the whole map's anywhere.
+  std::size_t compared = 0;
+  std::size_t within = 0;
+  for (int y = 0; y < g.sizeY(); ++y) {
+    for (int x = 0; x < g.sizeX(); ++x) {
+      const float got = band.distance_m[g.index(x, y)];
+      const float want = whole.distance_m[whole.grid.index(o.x + x, o.y + y)];
+      if (std::isnan(want)) continue;
+      ++compared;
+      // Obstacles missed (free cells) or free columns missed (occupied): never nearer.
+      EXPECT_GE(std::abs(got), std::abs(want)) << x << ", " << y;
+      const int edge = std::min({x, y, g.sizeX() - 1 - x, g.sizeY() - 1 - y});
+      // Within the computed box: the nearest column of the other kind is at most edge + 10
+      // columns away in every direction.
+      if (std::abs(want) / 0.05f + 0.5f <= static_cast<float>(edge + 10)) {
+        ++within;
+        EXPECT_EQ(got, want) << x << ", " << y;
+      }
+    }
+  }
+  EXPECT_GT(compared, 300u);
+  EXPECT_GT(within, 20u);
+  // Bounded below the grid itself: no padding, the grid still computed.
+  c.max_computed_columns = 100;
+  const EsdfBandSlice bare = esdfBandSlice(map, c);
+  EXPECT_TRUE(bare.stats.padding_cut);
+  EXPECT_EQ(bare.stats.padding_voxels, 0u);
+  EXPECT_EQ(bare.stats.columns_computed, 400u);
 }
 
 TEST(SliceWindow, BandEsdfRefusesAGridOffTheLattice) {

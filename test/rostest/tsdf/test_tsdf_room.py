@@ -173,6 +173,11 @@ class TsdfRoomTest(unittest.TestCase):
         stamp = max(set(self.slices) & set(self.distances))
         grid, cloud = self.slices[stamp], self.distances[stamp]
         self.assertEqual(self.status.get("slice distance cap (m)"), "2", self.status)
+        # The padding beyond the slice's grid: ceil(2 m / 4 cm + 1/2) = 51 columns, not narrowed
+        # (the room is far below 2 x ~slice_max_cells).
+        self.assertEqual(self.status.get("slice distance: padding (voxels)"), "51", self.status)
+        cuts = "slice distance: padding narrowed to 2 x slice_max_cells (total)"
+        self.assertEqual(self.status.get(cuts), "0", self.status)
         names = [f.name for f in cloud.fields]
         self.assertEqual(names, ["x", "y", "z", "distance"])
         points = np.array(list(point_cloud2.read_points(cloud, field_names=names)))

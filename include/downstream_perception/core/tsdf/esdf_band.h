@@ -31,6 +31,13 @@ struct EsdfBandConfig {
   /// over the grid grown by that much (within the blocks' extent) and is cropped, so the values
   /// inside equal the whole map's.
   std::optional<GridGeometry> grid;
+  /// At most this many columns computed (the grid and its padding; 0: no bound). The padding
+  /// alone can hold far more than the grid: a 2,000^2 window with a 100 m cap at 2 cm pads
+  /// 5,000 columns on each side, 144 M columns (1.3 GB). Over the bound the padding is narrowed
+  /// (EsdfBandStats::padding_cut): obstacles beyond it are then not seen, so a cell nearer the
+  /// grid's edge than the cap may read farther than in the whole map. The grid itself is always
+  /// computed (bound it with its own size).
+  std::size_t max_computed_columns = 0;
   /// Empty if valid for voxels of voxel_size_m, else the reason: finite min_z_m < max_z_m;
   /// max_distance_m finite, at least one voxel (as the ESDF's: a smaller cap would clamp every
   /// value, even the half voxel next to an obstacle) and at most kMaxDistanceM; a grid on the
@@ -46,6 +53,8 @@ struct EsdfBandStats {
   /// Columns the transform ran over: the grid grown by the cap (the padding), within the
   /// blocks' extent. Its working memory is kBytesPerComputedCell per such column.
   std::size_t columns_computed = 0;
+  std::size_t padding_voxels = 0;  ///< columns computed beyond the grid on each side
+  bool padding_cut = false;        ///< narrowed below the cap to fit max_computed_columns
   /// Labels (1 byte), squared distances and the transform's scratch (4 + 4); the result's float
   /// (4 bytes) per cell of the grid comes on top.
   static constexpr std::size_t kBytesPerComputedCell = 9;

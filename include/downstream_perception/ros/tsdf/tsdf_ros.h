@@ -144,6 +144,10 @@ class TsdfRos {
   std::size_t blocks_refused_ = 0;
   std::size_t slices_refused_ = 0;  ///< mesh ticks whose map extent fits no slice grid
   std::size_t slices_capped_ = 0;   ///< slices cut to ~slice_max_cells around the sensor
+  /// The clearance computes at most this many columns per ~slice_max_cells (window and padding):
+  /// 8 M columns, 72 MB of working memory, at the default cap.
+  static constexpr std::size_t kClearanceColumnsPerSliceCell = 2;
+  std::size_t clearance_padding_cuts_ = 0;  ///< clearances whose padding was narrowed to fit
   std::size_t blocks_evicted_ = 0;
   std::size_t pixels_no_return_ignored_ = 0;  ///< +Inf pixels carving refused to use (total)
   TimingStats integrate_ms_;
