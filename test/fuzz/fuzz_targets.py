@@ -1409,6 +1409,8 @@ def gen_esdf(rng: np.random.Generator) -> dict[str, Any]:
         "band": (g.f(-1, 1), g.f(0.5, 3), g.f(0.05, 3)),  # min_z_m, max_z_m, max_distance_m
         # Tsdf.slice_window: centre x, y (m), side (m), max_cells.
         "window": (g.f(-2, 4), g.f(-2, 4), g.f(0, 4), g.i(1, 3000)),
+        # esdf_band_slice's max_computed_columns over that window (0: no bound).
+        "padding_bound": g.i(0, 1500),
     }
 
 
@@ -1483,7 +1485,12 @@ def call_esdf(a: dict[str, Any]) -> Any:
             grid, capped = tsdf.slice_window(cx, cy, side, cells)
             if not window_valid:
                 problems.append(f"slice_window accepted {a['window']}")
-            window = (grid, capped, tsdf.esdf_band_slice(lo, hi, band_cap, grid))
+            window = (
+                grid,
+                capped,
+                tsdf.esdf_band_slice(lo, hi, band_cap, grid),
+                tsdf.esdf_band_slice(lo, hi, band_cap, grid, a["padding_bound"]),
+            )
         except (ValueError, TypeError) as error:  # TypeError: a count beyond int64
             if window_valid or not str(error):
                 raise
@@ -1520,7 +1527,9 @@ def garbage_esdf(a: dict[str, Any], r: Any) -> str | None:
         ):
             return "band slice column counts disagree with its signs"
     if r["window"] is not None:
-        problem = garbage_window(a["window"][3], band, *r["window"])
+        problem = garbage_window(a["window"][3], band, *r["window"][:3]) or garbage_padding(
+            a["padding_bound"], r["window"][2], r["window"][3]
+        )
         if problem:
             return problem
     v = r["voxel_distance"]
@@ -1557,6 +1566,25 @@ def garbage_window(
     expected = whole["distance"][y0 : y0 + ny, x0 : x0 + nx]
     if not np.array_equal(band["distance"], expected, equal_nan=True):
         return f"the band ESDF in window {grid} differs from the whole map's"
+    return None
+
+
+def garbage_padding(bound: int, free: dict[str, Any], bounded: dict[str, Any]) -> str | None:
+    """The band ESDF with its padding bounded: within the bound (or the grid alone), the same
+    known columns, and no value nearer than the unbounded one's."""
+    cells = free["distance"].size
+    if bound > 0 and bounded["columns_computed"] > max(bound, cells):
+        return f"{bounded['columns_computed']} columns computed over the bound {bound}"
+    if bounded["padding_voxels"] > free["padding_voxels"]:
+        return "a bounded padding wider than the free one"
+    if bounded["padding_cut"] != (bounded["padding_voxels"] < free["padding_voxels"]):
+        return "padding_cut disagrees with the padding"
+    got, want = bounded["distance"], free["distance"]
+    if not np.array_equal(np.isnan(got), np.isnan(want)):
+        return "a bounded padding changed which columns are known"
+    known = ~np.isnan(want)
+    if np.any(np.abs(got[known]) < np.abs(want[known])):
+        return "a bounded padding read a distance nearer than the whole map's"
     return None
 
 
