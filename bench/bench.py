@@ -228,17 +228,22 @@ def main() -> None:
         "",
         "| map | beams | integrate ms (p90) | layer update ms | costmap_2d ObstacleLayer ms "
         "| first scan ms | touched-window write ms | cell visits / scan | cells changed / scan "
-        "| Mcells/s |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| Mcells/s | walks run (per ray / blocks / reverse query / first visit / shared) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for row in core:
         ref = COSTMAP2D_OBSTACLE_MS.get((int(row["map"]), int(row["beams"])))
+        runs = row.get("auto_walk_runs", {})
+        walks = " / ".join(
+            str(runs.get(k, 0))
+            for k in ("per_ray", "blocks", "reverse_query", "first_visit", "shared")
+        )
         lines.append(
             f"| {int(row['map'])}^2 | {int(row['beams'])} | {row['median_ms']:.3f} "
             f"({row['p90_ms']:.3f}) | **{row['layer_update_ms']:.3f}** | "
             f"{'' if ref is None else f'{ref:.3f}'} | {row['first_scan_ms']:.3f} | "
             f"{row['touched_window_write_ms']:.3f} | {row['cells_per_scan']:.0f} | "
-            f"{row['cells_changed_per_scan']:.1f} | {row['mcells_per_s']:.1f} |"
+            f"{row['cells_changed_per_scan']:.1f} | {row['mcells_per_s']:.1f} | {walks} |"
         )
     lines += [
         "",
