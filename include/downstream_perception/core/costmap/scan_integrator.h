@@ -78,8 +78,10 @@ struct IntegrationStats {
 /// How pass 2 walks the clearing rays (src/core/costmap/scan_clearing.cpp). Both give the same
 /// grid, statistics and flag order bit for bit; only the time differs.
 enum class ClearingWalk {
-  /// The block skip for dense scans (the rays' cells add up to more than the cells of the box
-  /// they touch), else the per-ray walk: what the integrator runs.
+  /// What the integrator runs: over space the grid has not seen, the first-visit or mark-sweep
+  /// walk by rule; over seen space the walk (and thread count) timed fastest for this kind of
+  /// scan (WalkChooser, walk_chooser.h; through an IntegrationScratch: without one, the rule's
+  /// first guess: the reverse query / block walk for dense rays, else per ray).
   kAuto,
   /// Every cell of every ray is visited (the reference the block walk is tested against).
   kPerRay,

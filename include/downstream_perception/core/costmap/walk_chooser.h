@@ -2,16 +2,17 @@
 //
 // The clearing walks of scan_clearing.cpp give the same grid and statistics bit for bit, and which
 // one is fastest depends on the scan, the map and the machine: a sweep over maps of 200^2-1000^2,
-// 360-3600 beams and four sensor positions (bench notes in docs/benchmarks.md) found a fixed rule
-// (ClearingWalk::kAuto's thresholds, measured on one room) up to 1.7x slower than the best walk in
-// a third of the cases. Since the choice cannot change the result, it can be measured instead: the
-// chooser keeps, per kind of scan (a context: the rays' cells and their box, in octaves), the time
-// per ray cell of each walk, runs the fastest, and tries each other walk again after a number of
-// scans that doubles while it keeps losing (16 to 256 scans), so a walk that became faster (the
-// robot drove into a larger room) is found again while a walk that stays slower costs at most one
-// scan in 256. A trial's sample replaces the walk's old figure (the scene may have changed since);
-// the running walk's figure is a moving average, with samples capped at 3x it so one preempted
-// scan does not make it look slow.
+// 360-3600 beams and four sensor positions (docs/benchmarks.md) found the fixed rule
+// (ClearingWalk::kAuto's thresholds, measured on one room) more than 1.15x slower than the best
+// walk in 10 of 60 cases, up to 1.59x. Since the choice cannot change the result, it can be
+// measured instead: the chooser keeps, per kind of scan (a context: the rays' cells and their box,
+// in octaves), the time per ray cell of each walk, runs the fastest, and tries each other walk
+// again after a number of scans that doubles while it keeps losing (16 to 256 scans), so a walk
+// that became faster (the robot drove into a larger room) is found again while a walk that stays
+// slower costs at most one scan in 256. Dense scans also choose between one and two threads (the
+// shared walks). A trial's sample replaces the walk's old figure (the scene may have changed
+// since); the running walk's figure is a moving average, with samples capped at 3x it so one
+// preempted scan does not make it look slow.
 #pragma once
 
 #include <array>
