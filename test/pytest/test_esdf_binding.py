@@ -184,6 +184,14 @@ def test_band_slice_is_the_2d_esdf_of_the_bands_columns_and_the_rooms_clearance(
         tsdf.esdf_band_slice(0.05, 1.8, 0.0)
 
 
+def whole_in(whole: dict, grid: dp.GridGeometry) -> np.ndarray:
+    """The whole map's band ESDF (esdf_band_slice without a grid) over the cells of `grid`."""
+    g0 = whole["grid"]
+    x0 = round((grid.origin_x - g0.origin_x) / VOXEL)
+    y0 = round((grid.origin_y - g0.origin_y) / VOXEL)
+    return whole["distance"][y0 : y0 + grid.size_y, x0 : x0 + grid.size_x]
+
+
 def test_band_slice_in_a_window_is_the_whole_maps_there() -> None:
     # Tsdf.slice_window (the nodelet's ~slice_window_m and ~slice_max_cells) and the band's ESDF
     # over it: the transform runs over the window grown by the cap and is cropped, so inside the
@@ -191,7 +199,6 @@ def test_band_slice_in_a_window_is_the_whole_maps_there() -> None:
     tsdf = make_tsdf()
     integrate(tsdf, room_scene(), circle_poses(8))
     whole = tsdf.esdf_band_slice(max_distance_m=1.0)
-    g0 = whole["grid"]
     # 1 m at 5 cm: 20 columns; x = 1.63 is column 33 (floor(32.6 + 0.5)), index 10 of the
     # window: columns 23..42, origin 22.5 voxels = 1.125 m; y = -0.41: column -8, -18..1.
     grid, capped = tsdf.slice_window(1.63, -0.41, 1.0)
@@ -207,9 +214,7 @@ def test_band_slice_in_a_window_is_the_whole_maps_there() -> None:
             grid.origin_x,
             grid.origin_y,
         )
-        x0 = round((grid.origin_x - g0.origin_x) / VOXEL)
-        y0 = round((grid.origin_y - g0.origin_y) / VOXEL)
-        expected = whole["distance"][y0 : y0 + grid.size_y, x0 : x0 + grid.size_x]
+        expected = whole_in(whole, grid)
         np.testing.assert_array_equal(band["distance"], expected)
         assert band["columns_occupied"] == int((expected < 0).sum())
         assert band["columns_computed"] >= grid.size_x * grid.size_y
@@ -237,16 +242,13 @@ def test_band_slice_padding_is_bounded_by_max_computed_columns() -> None:
     tsdf = make_tsdf()
     integrate(tsdf, room_scene(), circle_poses(8))
     whole = tsdf.esdf_band_slice(max_distance_m=1.0)
-    g0 = whole["grid"]
     grid, _ = tsdf.slice_window(1.63, -0.41, 1.0)
     free = tsdf.esdf_band_slice(max_distance_m=1.0, grid=grid)
     assert (free["padding_voxels"], free["padding_cut"]) == (21, False)
     band = tsdf.esdf_band_slice(max_distance_m=1.0, grid=grid, max_computed_columns=30 * 30)
     assert (band["padding_voxels"], band["padding_cut"]) == (5, True)
     assert band["columns_computed"] <= 30 * 30
-    x0 = round((grid.origin_x - g0.origin_x) / VOXEL)
-    y0 = round((grid.origin_y - g0.origin_y) / VOXEL)
-    expected = whole["distance"][y0 : y0 + grid.size_y, x0 : x0 + grid.size_x]
+    expected = whole_in(whole, grid)
     got = band["distance"]
     known = ~np.isnan(expected)
     assert known.sum() > 100
