@@ -27,20 +27,6 @@ VoxelLayers bandLayers(double min_z_m, double max_z_m, double voxel_size_m) {
           static_cast<int>(std::floor(max_z_m / voxel_size_m))};
 }
 
-GridGeometry sliceGeometry(const TsdfMap& map) {
-  if (map.blockCount() == 0) return GridGeometry();
-  Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max());
-  Eigen::Vector2i hi = Eigen::Vector2i::Constant(std::numeric_limits<int>::min());
-  for (const auto& kv : map.blocks()) {
-    lo = lo.cwiseMin(kv.first.head<2>());
-    hi = hi.cwiseMax(kv.first.head<2>());
-  }
-  const double s = map.voxelSize();
-  return GridGeometry((hi.x() - lo.x() + 1) * kTsdfBlockSide,
-                      (hi.y() - lo.y() + 1) * kTsdfBlockSide, s,
-                      (lo.x() * kTsdfBlockSide - 0.5) * s, (lo.y() * kTsdfBlockSide - 0.5) * s);
-}
-
 ColumnBox blockColumns(const TsdfMap& map) {
   ColumnBox box;
   if (map.blockCount() == 0) return box;
@@ -55,6 +41,25 @@ ColumnBox blockColumns(const TsdfMap& map) {
     box.max_y = std::max(box.max_y, y + kTsdfBlockSide - 1);
   }
   return box;
+}
+
+namespace {
+
+/// One cell per column of `box` (voxel centres in the middle of the cells); invalid (0 x 0) for
+/// an empty box. GridGeometry refuses (throws) a box beyond its per-axis and total limits.
+GridGeometry columnGrid(const ColumnBox& box, double voxel_size_m) {
+  if (box.empty()) return GridGeometry();
+  return GridGeometry(
+      static_cast<int>(std::min<std::int64_t>(box.width(), std::numeric_limits<int>::max())),
+      static_cast<int>(std::min<std::int64_t>(box.height(), std::numeric_limits<int>::max())),
+      voxel_size_m, (static_cast<double>(box.min_x) - 0.5) * voxel_size_m,
+      (static_cast<double>(box.min_y) - 0.5) * voxel_size_m);
+}
+
+}  // namespace
+
+GridGeometry sliceGeometry(const TsdfMap& map) {
+  return columnGrid(blockColumns(map), map.voxelSize());
 }
 
 std::string SliceWindow::validate() const {
@@ -125,10 +130,7 @@ GridGeometry sliceWindowGeometry(const ColumnBox& columns, double voxel_size_m,
     box = box.intersected(squareAround(window.centre_x_m, window.centre_y_m, voxel_size_m, n));
     if (capped != nullptr) *capped = true;
   }
-  if (box.empty()) return GridGeometry();
-  return GridGeometry(static_cast<int>(box.width()), static_cast<int>(box.height()), voxel_size_m,
-                      (static_cast<double>(box.min_x) - 0.5) * voxel_size_m,
-                      (static_cast<double>(box.min_y) - 0.5) * voxel_size_m);
+  return columnGrid(box, voxel_size_m);
 }
 
 std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
