@@ -20,10 +20,15 @@ from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs.msg import LaserScan
 from tf2_ros import StaticTransformBroadcaster
 
-from downstream_perception.msg import DetectedObject, DetectedObjectArray
+from downstream_perception.msg import DetectedObjectArray
 from downstream_perception.planar import se2_matrix
 from downstream_perception.ros.costmap_client import CostmapClient
-from downstream_perception.ros.util import laser_scan, transform_stamped, wait_until
+from downstream_perception.ros.util import (
+    detection_array,
+    laser_scan,
+    transform_stamped,
+    wait_until,
+)
 from downstream_perception.sim import Lidar, LidarConfig
 from downstream_perception.sim.world import MovingCircle, World
 
@@ -108,19 +113,12 @@ class TrackedClearingTest(unittest.TestCase):
     @classmethod
     def publish_detection(cls, stamp: rospy.Time, t: float) -> None:
         x, y, _ = BASE_MAP @ np.array([CART_X, cls.cart_y(t), 1.0])
-        msg = DetectedObjectArray()
-        msg.header.stamp = stamp
-        msg.header.frame_id = "base_link"
-        d = DetectedObject()
-        d.header = msg.header
-        d.kind = DetectedObject.POSITION
-        d.score = 0.9
-        d.position.x, d.position.y = float(x), float(y)
-        d.position_covariance = [1e-4, 0.0, 0.0, 1e-4]
-        d.size_x = d.size_y = 2 * CART_RADIUS
-        d.truth_id = 1
-        msg.detections.append(d)
-        cls.detections.publish(msg)
+        cls.detections.publish(
+            detection_array(
+                stamp, "base_link", np.array([[x, y]]), np.array([0.9]), np.array([1]), 1e-4,
+                sizes=np.full((1, 2), 2 * CART_RADIUS),
+            )
+        )  # fmt: skip
 
     def lethal_cells(self, key: str) -> tuple[np.ndarray, np.ndarray]:
         """Map coordinates (x, y) of every lethal cell's centre."""

@@ -20,10 +20,10 @@ import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from tf2_ros import StaticTransformBroadcaster
 
-from downstream_perception.msg import DetectedObject, DetectedObjectArray, TrackedObjectArray
+from downstream_perception.msg import DetectedObjectArray, TrackedObjectArray
 from downstream_perception.planar import se2_matrix
 from downstream_perception.ros.costmap_client import CostmapClient
-from downstream_perception.ros.util import transform_stamped, wait_until
+from downstream_perception.ros.util import detection_array, transform_stamped, wait_until
 
 SPEED = -0.6  # m/s along map x
 Y = 4.0921  # m: row floor(4.0921 / 0.05) = 81
@@ -67,19 +67,13 @@ class TrackedObstaclesTest(unittest.TestCase):
             if t >= 0.0:
                 p_map = np.array([cls.x0 + SPEED * t, Y, 1.0])
                 x, y, _ = BASE_FROM_MAP @ p_map
-                msg = DetectedObjectArray()
-                msg.header.stamp = stamp
-                msg.header.frame_id = "base_link"
-                d = DetectedObject()
-                d.header = msg.header
-                d.kind = DetectedObject.POSITION
-                d.score = 0.9
-                d.position.x, d.position.y = float(x), float(y)
-                d.position_covariance = [1e-4, 0.0, 0.0, 1e-4]
-                d.size_x = d.size_y = 0.0  # the lesson's point object
-                d.truth_id = 1
-                msg.detections.append(d)
-                cls.detections.publish(msg)
+                # The lesson's point object: size 0.
+                cls.detections.publish(
+                    detection_array(
+                        stamp, "base_link", np.array([[x, y]]), np.array([0.9]), np.array([1]),
+                        1e-4, sizes=np.zeros((1, 2)),
+                    )
+                )  # fmt: skip
             rate.sleep()
 
     def test_corridor_then_expiry(self) -> None:
