@@ -154,6 +154,24 @@ TEST(SliceWindow, BlockColumnsOfAMap) {
   EXPECT_EQ(sliceWindowGeometry(box, kVoxel, window(0.0, 0.0, 0.0)), sliceGeometry(map));
 }
 
+TEST(SliceWindow, AnExtentBeyondAGridIsRefusedNotWrapped) {
+  TsdfConfig c;
+  c.voxel_size_m = kVoxel;
+  TsdfMap map(c);
+  // The farthest blocks the map's index range allows on either side: 2^31 columns apart, past
+  // an int (the old per-axis count wrapped to a negative size) and past GridGeometry's limit.
+  constexpr int kFarBlock = TsdfMap::kMaxVoxelIndex / kTsdfBlockSide;
+  ASSERT_NE(map.allocate({-kFarBlock, 0, 0}), nullptr);
+  ASSERT_NE(map.allocate({kFarBlock - 1, 0, 0}), nullptr);
+  const ColumnBox box = blockColumns(map);
+  EXPECT_EQ(box.width(), std::int64_t{1} << 31);
+  EXPECT_THROW(sliceGeometry(map), std::invalid_argument);
+  // A window around the sensor still gives a grid over such a map.
+  const GridGeometry g = sliceWindowGeometry(box, kVoxel, window(0.0, 0.0, 2.0));
+  EXPECT_EQ(g.sizeX(), 20);
+  EXPECT_EQ(g.sizeY(), kTsdfBlockSide);  // the one block row
+}
+
 namespace {
 
 /// Windows over the 5 cm room (blocks cover about -2.4 .. 2.4 m): inside, across a wall, over a
