@@ -112,6 +112,13 @@ void InflationLayer::noteRadiusDifference(double resolution) {
            toText(theirs * resolution) + " m), this layer to the radius itself (" +
            toText(inflator_->radiusCells()) + " whole cells)";
   }
+  const double tie_cells = inscribedTieCells(config_, resolution);
+  if (tie_cells > 0.0) {
+    note += std::string(note.empty() ? "" : "; ") + "cells exactly at the inscribed radius " +
+            toText(config_.inscribed_radius) + " m (" + toText(tie_cells) +
+            " cells) cost 253 (inscribed) here, where costmap_2d's double comparison puts them "
+            "outside it (251)";
+  }
   if (!note.empty() && note != radius_note_)
     ROS_WARN("layer '%s': %s", name_.c_str(), note.c_str());
   radius_note_ = note;

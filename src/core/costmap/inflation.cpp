@@ -74,6 +74,27 @@ std::uint8_t inflationCost(double distance_m, const InflationConfig& config) {
   return static_cast<std::uint8_t>((cost::kInscribedInflatedObstacle - 1) * factor);
 }
 
+double inscribedTieCells(const InflationConfig& config, double resolution_m) {
+  const double inscribed = config.inscribed_radius;
+  if (!(inscribed > 0.0) || !(resolution_m > 0.0) || !std::isfinite(inscribed)) return 0.0;
+  // Only cells next to the circle of the inscribed radius can tie: per column i the rows around
+  // sqrt(r^2 - i^2) (r in cells), so O(r) work however large the footprint.
+  const double r = std::min(inscribed / resolution_m, double{InflationConfig::kMaxRadiusCells});
+  double nearest = 0.0;
+  for (int i = 0; i <= static_cast<int>(r) + 1; ++i) {
+    const double t = r * r - static_cast<double>(i) * i;
+    const int j0 = static_cast<int>(std::sqrt(std::max(t, 0.0)));
+    for (int j = std::max(0, j0 - 1); j <= j0 + 1; ++j) {
+      const double cells = std::hypot(static_cast<double>(i), static_cast<double>(j));
+      const double d = cells * resolution_m;
+      if (d == 0.0 || d > config.inflation_radius) continue;
+      const bool ours = inflationCost(d, config) == cost::kInscribedInflatedObstacle;
+      if (ours != (d <= inscribed) && (nearest == 0.0 || cells < nearest)) nearest = cells;
+    }
+  }
+  return nearest;
+}
+
 void boundedSquaredDistances(const std::uint8_t* lethal, int stride, const CellBounds& source_box,
                              const CellBounds& out_box, int max_distance_cells,
                              std::vector<std::int32_t>* out) {

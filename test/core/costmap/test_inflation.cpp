@@ -93,6 +93,41 @@ TEST(InflationCost, LessonGoldenNumbers) {
   EXPECT_EQ(inflationCost(13 * 0.05, c), 0);   // beyond it
 }
 
+// costmap_2d's inscribed test is hypot(dx, dy) * resolution <= inscribed in plain doubles; the
+// cases worked by hand in double arithmetic.
+TEST(InflationCost, InscribedTieAgainstCostmap2dIsFoundWhereTheDoublesRoundUp) {
+  InflationConfig c;
+  c.inflation_radius = 0.55;
+  c.inscribed_radius = 0.3;
+  // 6 * 0.05 = 0.30000000000000004 > 0.3: costmap_2d's cell 6 is outside, ours inside.
+  EXPECT_GT(6 * 0.05, 0.3);
+  EXPECT_EQ(inflationCost(6 * 0.05, c), 253);
+  EXPECT_DOUBLE_EQ(inscribedTieCells(c, 0.05), 6.0);
+  // 3 * 0.1 = 0.30000000000000004 too.
+  EXPECT_DOUBLE_EQ(inscribedTieCells(c, 0.1), 3.0);
+  // 5 * 0.05 rounds to exactly 0.25: both call it inscribed, no difference.
+  c.inscribed_radius = 0.25;
+  EXPECT_EQ(5 * 0.05, 0.25);
+  EXPECT_EQ(inscribedTieCells(c, 0.05), 0.0);
+  // Not a whole number of cells, and beyond the inflation radius: no tie to name.
+  c.inscribed_radius = 0.32;
+  EXPECT_EQ(inscribedTieCells(c, 0.05), 0.0);
+  c.inscribed_radius = 0.3;
+  c.inflation_radius = 0.2;
+  EXPECT_EQ(inscribedTieCells(c, 0.05), 0.0);
+  // 3-4-5: cell (3, 4) is 5 cells out, 5 * 0.1 = 0.5 exactly: no tie; 0.7 = 7 * 0.1 rounds up.
+  c.inflation_radius = 1.0;
+  c.inscribed_radius = 0.5;
+  EXPECT_EQ(inscribedTieCells(c, 0.1), 0.0);
+  c.inscribed_radius = 0.7;
+  EXPECT_GT(7 * 0.1, 0.7);
+  EXPECT_DOUBLE_EQ(inscribedTieCells(c, 0.1), 7.0);
+  // Degenerate inputs name nothing.
+  EXPECT_EQ(inscribedTieCells(c, 0.0), 0.0);
+  c.inscribed_radius = 0.0;
+  EXPECT_EQ(inscribedTieCells(c, 0.1), 0.0);
+}
+
 TEST(InflationCost, TableMatchesFormulaForEverySquaredDistance) {
   InflationConfig c;
   c.inflation_radius = 1.0;

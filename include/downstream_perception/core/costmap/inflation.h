@@ -59,6 +59,13 @@ struct InflationConfig {
 /// costmap_2d's cost for a cell at `distance_m` from the nearest lethal cell.
 std::uint8_t inflationCost(double distance_m, const InflationConfig& config);
 
+/// The distance (cells, > 0) of the nearest cell within the inflation radius whose cost differs
+/// from costmap_2d's only by the inscribed tie, else 0. costmap_2d calls a cell inscribed when
+/// hypot(dx, dy) * resolution <= inscribed radius in plain doubles, so a cell exactly at the
+/// radius goes either way with the rounding (6 * 0.05 = 0.30000000000000004 > 0.3); inflationCost
+/// counts it (1e-6 relative tolerance). For the layer's once-only WARN.
+double inscribedTieCells(const InflationConfig& config, double resolution_m);
+
 /// Squared distances (cells^2) from every cell of `out_box` to the nearest cell with
 /// lethal[y * stride + x] != 0 among the cells of `source_box`, capped: values above
 /// max_distance_cells^2 come out as kFarSquared. out_box must lie inside source_box.
