@@ -117,7 +117,7 @@ void InflationLayer::noteRadiusDifference(double resolution) {
     note += std::string(note.empty() ? "" : "; ") + "cells exactly at the inscribed radius " +
             toText(config_.inscribed_radius) + " m (" + toText(tie_cells) +
             " cells) cost 253 (inscribed) here, where costmap_2d's double comparison puts them "
-            "outside it (251)";
+            "just outside it (251 or 252)";
   }
   if (!note.empty() && note != radius_note_)
     ROS_WARN("layer '%s': %s", name_.c_str(), note.c_str());
