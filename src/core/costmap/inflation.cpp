@@ -1,6 +1,7 @@
 #include "downstream_perception/core/costmap/inflation.h"
 
 #include "downstream_perception/core/grid/grid_shift.h"
+#include "downstream_perception/core/parallel/avx2_clones.h"
 #include "inflation_detail.h"
 
 #include <algorithm>
@@ -339,14 +340,10 @@ void Inflator::recomputeDirtyTiles(const GridGeometry& g, InflationStats* stats)
   dirty_tile_box_ = CellBounds{};
 }
 
-// The window's lethal compare and merge vectorise twice as wide with AVX2: GCC builds an AVX2
-// copy next to the baseline one and the loader picks the one the CPU runs (as the TSDF
-// integrator and writeStateCosts). Integer compares and selects: both copies give the same bytes.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-InflationStats
-Inflator::update(Costmap* master, const CellBounds& window) {
+// The window's lethal compare and merge vectorise twice as wide with AVX2 (avx2_clones.h).
+// Integer compares and selects: both copies give the same bytes.
+DP_AVX2_CLONES
+InflationStats Inflator::update(Costmap* master, const CellBounds& window) {
   InflationStats stats;
   const GridGeometry& g = master->geometry();
   if (g.cellCount() == 0) return stats;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "downstream_perception/core/costmap/inflation.h"
+#include "downstream_perception/core/parallel/avx2_clones.h"
 #include "inflation_detail.h"
 
 namespace downstream_perception {
@@ -80,11 +81,9 @@ std::vector<CellBounds> Inflator::bandRegions(const GridGeometry& g,
   return regions;
 }
 
-// The pass over the master (lethal set, starting costs) vectorises twice as wide with AVX2: an
-// AVX2 copy next to the baseline one, picked by the loader (see Inflator::update).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+// The pass over the master (lethal set, starting costs) vectorises twice as wide with AVX2
+// (avx2_clones.h).
+DP_AVX2_CLONES
 void Inflator::recomputeAll(const std::uint8_t* master, const GridGeometry& g,
                             InflationStats* stats) {
   const int size_x = g.sizeX();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "downstream_perception/core/parallel/avx2_clones.h"
+
 namespace downstream_perception {
 
 std::string validateCombinationMethod(int code) {
@@ -35,16 +37,11 @@ void writeRow(const std::int16_t* in, std::uint8_t* dst, int width, std::int16_t
 
 }  // namespace
 
-// The rows vectorise twice as wide with AVX2 (a map's window is up to millions of cells per
-// update): as DepthIntegrator::integrate, GCC builds an AVX2 copy next to the baseline one and the
-// loader picks the one the CPU runs. Integer compares and selects only: both copies write the same
-// bytes.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-std::size_t
-writeStateCosts(const LogOddsGrid& grid, const CellBounds& window, bool write_unknown,
-                std::uint8_t unknown_cost, Costmap* master, CombinationMethod method) {
+// The rows vectorise twice as wide with AVX2 (avx2_clones.h; a map's window is up to millions of
+// cells per update). Integer compares and selects only: both copies write the same bytes.
+DP_AVX2_CLONES
+std::size_t writeStateCosts(const LogOddsGrid& grid, const CellBounds& window, bool write_unknown,
+                            std::uint8_t unknown_cost, Costmap* master, CombinationMethod method) {
   if (master == nullptr || !(grid.geometry() == master->geometry())) {
     throw std::invalid_argument(
         "writeStateCosts: the master grid's geometry differs from the layer's");

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <utility>
 
+#include "downstream_perception/core/parallel/avx2_clones.h"
+
 namespace downstream_perception {
 
 std::string PinholeCamera::validate() const {
@@ -504,15 +506,12 @@ DepthIntegrator::~DepthIntegrator() = default;
 DepthIntegrator::DepthIntegrator(DepthIntegrator&&) noexcept = default;
 DepthIntegrator& DepthIntegrator::operator=(DepthIntegrator&&) noexcept = default;
 
-// The per-pixel and per-voxel loops vectorise twice as wide with AVX2: on x86-64 Linux GCC
-// builds an AVX2 copy next to the baseline one, and the loader picks the copy the CPU runs (an
-// ifunc). No FMA in the AVX2 copy, so both give bit-identical maps.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-TsdfIntegrationStats
-DepthIntegrator::integrate(TsdfMap* map, const float* depth, const PinholeCamera& camera,
-                           const Eigen::Isometry3d& T_map_camera) {
+// The per-pixel and per-voxel loops vectorise twice as wide with AVX2 (avx2_clones.h): both
+// copies give bit-identical maps.
+DP_AVX2_CLONES
+TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth,
+                                                const PinholeCamera& camera,
+                                                const Eigen::Isometry3d& T_map_camera) {
   DepthFrame* scratch = buffers_.get();
   TsdfIntegrationStats stats;
   const TsdfConfig& c = map->config();
