@@ -79,6 +79,7 @@ try:
         TrackState,
         Tsdf,
         TsdfConfig,
+        TsdfEdgeGuardRule,
         TsdfIntegrationStats,
         TsdfWeighting,
         VoxelMap,

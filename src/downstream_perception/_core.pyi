@@ -39,6 +39,7 @@ __all__: list[str] = [
     "TrackerStats",
     "Tsdf",
     "TsdfConfig",
+    "TsdfEdgeGuardRule",
     "TsdfIntegrationStats",
     "TsdfWeighting",
     "VoxelMap",
@@ -381,6 +382,39 @@ class TsdfWeighting:
     @property
     def value(self) -> int: ...
 
+class TsdfEdgeGuardRule:
+    """
+    Members:
+
+      RIM_DISTANCE
+
+      FIXED_RADIUS
+    """
+
+    FIXED_RADIUS: typing.ClassVar[TsdfEdgeGuardRule]
+    RIM_DISTANCE: typing.ClassVar[TsdfEdgeGuardRule]
+    __members__: typing.ClassVar[dict[str, TsdfEdgeGuardRule]]
+    @typing.overload
+    def __eq__(self, other: TsdfEdgeGuardRule) -> bool: ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool: ...
+    def __getstate__(self) -> int: ...
+    def __hash__(self) -> int: ...
+    def __index__(self) -> int: ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    def __int__(self) -> int: ...
+    @typing.overload
+    def __ne__(self, other: TsdfEdgeGuardRule) -> bool: ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool: ...
+    def __repr__(self) -> str: ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    def __str__(self) -> str: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def value(self) -> int: ...
+
 class TsdfConfig:
     """
     Parameters of the sparse TSDF (voxel size and truncation in metres, weights, memory bounds).
@@ -420,7 +454,7 @@ class TsdfConfig:
     @property
     def edge_guard_grazing_voxels(self) -> float:
         """
-        Edge guard: a guarded pixel beside the rim (not the rim pixel itself) still updates voxels up to voxel_size_m / cos(incidence) behind its surface, at most this many voxels (a face seen edge-on next to a rim needs them); 1 = a voxel at any incidence.
+        FIXED_RADIUS only: a guarded pixel beside the rim (not the rim pixel itself) still updates voxels up to voxel_size_m / cos(incidence) behind its surface, at most this many voxels; 1 = a voxel at any incidence.
         """
     @edge_guard_grazing_voxels.setter
     def edge_guard_grazing_voxels(
@@ -429,17 +463,47 @@ class TsdfConfig:
     @property
     def edge_guard_near_side_only(self) -> bool:
         """
-        Edge guard: only the nearer side of a depth edge (the object's rim) is guarded, and only pixels at most mu farther than the rim; false: both sides and every pixel within edge_guard_rad (the guard before).
+        Edge guard: only the nearer side of a depth edge (the object's rim) is a rim (FIXED_RADIUS: guarded pixels at most mu farther than it); false: both sides.
         """
     @edge_guard_near_side_only.setter
     def edge_guard_near_side_only(self, arg0: bool) -> None: ...
     @property
     def edge_guard_rad(self) -> float:
         """
-        Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle (rad) of a depth edge (a jump of more than mu) are not updated. Rays grazing an object's rim would otherwise write "inside" values into the free space beyond its edges (the projective TSDF's ghost surfaces). A depth edge: neighbouring pixels more than mu apart in depth (or one invalid) that do not continue one plane. 0.0075 rad is 2 pixels at f = 262, 4 at f = 525; 0 disables.
+        0 disables the edge guard. FIXED_RADIUS: pixels within this angle (rad) of a depth edge are guarded; RIM_DISTANCE: pixels without an incidence estimate within it update a voxel deep. 0.0075 rad is 2 pixels at f = 262.
         """
     @edge_guard_rad.setter
     def edge_guard_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def edge_guard_rim_scale(self) -> float:
+        """
+        RIM_DISTANCE: scales the depth a pixel's distance from the rim allows (larger: more surface next to rims, more ghosts).
+        """
+    @edge_guard_rim_scale.setter
+    def edge_guard_rim_scale(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def edge_guard_rule(self) -> TsdfEdgeGuardRule:
+        """
+        Depth images: how deep behind the surface pixels next to a depth edge (an object's rim) write inside values (rays grazing a rim would otherwise write them into the free space beyond it: ghosts). RIM_DISTANCE: from each pixel's distance to the nearest rim and its incidence angle; FIXED_RADIUS: a voxel within edge_guard_rad of a rim (the rule before issue 22).
+        """
+    @edge_guard_rule.setter
+    def edge_guard_rule(self, arg0: TsdfEdgeGuardRule) -> None: ...
+    @property
+    def grazing_reach_max_voxels(self) -> float:
+        """
+        Cap (voxels along the ray) of the grazing reach; below truncation_voxels it acts as truncation_voxels.
+        """
+    @grazing_reach_max_voxels.setter
+    def grazing_reach_max_voxels(
+        self, arg0: typing.SupportsFloat | typing.SupportsIndex
+    ) -> None: ...
+    @property
+    def grazing_reach_voxels(self) -> float:
+        """
+        Depth images: every pixel writes inside values down to this many voxels below its surface (that / cos(incidence) along the ray), beyond mu if need be, at most grazing_reach_max_voxels along the ray; 0 = off.
+        """
+    @grazing_reach_voxels.setter
+    def grazing_reach_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def interpolate_depth(self) -> bool:
         """
@@ -668,7 +732,7 @@ class Tsdf:
         centre_y_m: typing.SupportsFloat | typing.SupportsIndex,
         side_m: typing.SupportsFloat | typing.SupportsIndex = 0.0,
         max_cells: typing.SupportsInt | typing.SupportsIndex = 4000000,
-    ) -> tuple:
+    ) -> tuple[GridGeometry, bool]:
         """
         The nodelet's slice grid (~slice_window_m, ~slice_max_cells): (GridGeometry, capped). A square of round(side_m / voxel) voxel columns whose middle column (n // 2) holds the centre (m), cut to the blocks' x-y extent; side_m 0: the whole extent. Larger than max_cells: cut to the floor(sqrt(max_cells)) square around the centre, capped True. An empty (0 x 0) grid when it misses every block. For Tsdf.slice and Tsdf.esdf_band_slice(grid=...). Raises ValueError on a side outside [0, 1e5] m, max_cells outside [1, 2^28] or a centre that is not finite.
         """

@@ -210,6 +210,9 @@ void bindTsdf(py::module& m) {
   py::enum_<TsdfConfig::Weighting>(m, "TsdfWeighting")
       .value("CONSTANT", TsdfConfig::Weighting::kConstant)
       .value("INVERSE_SQUARE_DEPTH", TsdfConfig::Weighting::kInverseSquareDepth);
+  py::enum_<TsdfConfig::EdgeGuardRule>(m, "TsdfEdgeGuardRule")
+      .value("RIM_DISTANCE", TsdfConfig::EdgeGuardRule::kRimDistance)
+      .value("FIXED_RADIUS", TsdfConfig::EdgeGuardRule::kFixedRadius);
   py::class_<TsdfConfig>(m, "TsdfConfig",
                          "Parameters of the sparse TSDF (voxel size and truncation in metres, "
                          "weights, memory bounds).")
@@ -233,23 +236,34 @@ void bindTsdf(py::module& m) {
                      "With behind_surface_dropoff, the weight stays 1 up to this many voxels "
                      "behind the surface, then falls linearly to 0 at -mu (1 = voxblox's ramp; "
                      ">= truncation_voxels = no ramp).")
+      .def_readwrite("edge_guard_rule", &TsdfConfig::edge_guard_rule,
+                     "Depth images: how deep behind the surface pixels next to a depth edge (an "
+                     "object's rim) write inside values (rays grazing a rim would otherwise "
+                     "write them into the free space beyond it: ghosts). RIM_DISTANCE: from each "
+                     "pixel's distance to the nearest rim and its incidence angle; FIXED_RADIUS: "
+                     "a voxel within edge_guard_rad of a rim (the rule before issue 22).")
       .def_readwrite("edge_guard_rad", &TsdfConfig::edge_guard_rad,
-                     "Depth images: voxels more than a voxel behind the surface seen by a pixel "
-                     "within this angle (rad) of a depth edge (a jump of more than mu) are not "
-                     "updated. Rays grazing an object's rim would otherwise write \"inside\" "
-                     "values into the free space beyond its edges (the projective TSDF's ghost "
-                     "surfaces). A depth edge: neighbouring pixels more than mu apart in depth "
-                     "(or one invalid) that do not continue one plane. 0.0075 rad is 2 pixels "
-                     "at f = 262, 4 at f = 525; 0 disables.")
+                     "0 disables the edge guard. FIXED_RADIUS: pixels within this angle (rad) of "
+                     "a depth edge are guarded; RIM_DISTANCE: pixels without an incidence "
+                     "estimate within it update a voxel deep. 0.0075 rad is 2 pixels at f = 262.")
       .def_readwrite("edge_guard_near_side_only", &TsdfConfig::edge_guard_near_side_only,
-                     "Edge guard: only the nearer side of a depth edge (the object's rim) is "
-                     "guarded, and only pixels at most mu farther than the rim; false: both "
-                     "sides and every pixel within edge_guard_rad (the guard before).")
+                     "Edge guard: only the nearer side of a depth edge (the object's rim) is a "
+                     "rim (FIXED_RADIUS: guarded pixels at most mu farther than it); false: "
+                     "both sides.")
+      .def_readwrite("edge_guard_rim_scale", &TsdfConfig::edge_guard_rim_scale,
+                     "RIM_DISTANCE: scales the depth a pixel's distance from the rim allows "
+                     "(larger: more surface next to rims, more ghosts).")
       .def_readwrite("edge_guard_grazing_voxels", &TsdfConfig::edge_guard_grazing_voxels,
-                     "Edge guard: a guarded pixel beside the rim (not the rim pixel itself) still "
-                     "updates voxels up to voxel_size_m / "
-                     "cos(incidence) behind its surface, at most this many voxels (a face seen "
-                     "edge-on next to a rim needs them); 1 = a voxel at any incidence.")
+                     "FIXED_RADIUS only: a guarded pixel beside the rim (not the rim pixel "
+                     "itself) still updates voxels up to voxel_size_m / cos(incidence) behind "
+                     "its surface, at most this many voxels; 1 = a voxel at any incidence.")
+      .def_readwrite("grazing_reach_voxels", &TsdfConfig::grazing_reach_voxels,
+                     "Depth images: every pixel writes inside values down to this many voxels "
+                     "below its surface (that / cos(incidence) along the ray), beyond mu if need "
+                     "be, at most grazing_reach_max_voxels along the ray; 0 = off.")
+      .def_readwrite("grazing_reach_max_voxels", &TsdfConfig::grazing_reach_max_voxels,
+                     "Cap (voxels along the ray) of the grazing reach; below truncation_voxels "
+                     "it acts as truncation_voxels.")
       .def_readwrite(
           "interpolate_depth", &TsdfConfig::interpolate_depth,
           "Depth images: read each voxel's depth by interpolating inverse depth between the four "

@@ -1261,6 +1261,10 @@ def tsdf_config_args(g: Gen) -> dict[str, Any]:
         "edge_guard_rad": g.f(0, 0.01, 0.1),
         "edge_guard_near_side_only": g.b(),
         "edge_guard_grazing_voxels": g.f(1, 4, 0.1),
+        "edge_guard_rim_scale": g.f(0.2, 3, 0.1),
+        "grazing_reach_voxels": g.f(0, 3, 0.1),
+        "grazing_reach_max_voxels": g.f(1, 32, 0.1),
+        "edge_guard_rule": g.pick(("RIM_DISTANCE", "FIXED_RADIUS")),
         "interpolate_depth": g.b(),
         "carve_free_space": g.chance(0.3),
         "min_depth_m": g.f(0.05, 0.3, 0.1),
@@ -1275,7 +1279,8 @@ def tsdf_config_args(g: Gen) -> dict[str, Any]:
 def make_tsdf_config(fields: dict[str, Any]) -> Any:
     c = core()
     weighting = getattr(c.TsdfWeighting, fields["weighting"])
-    return configure(c.TsdfConfig(), {**fields, "weighting": weighting})
+    rule = getattr(c.TsdfEdgeGuardRule, fields.get("edge_guard_rule", "RIM_DISTANCE"))
+    return configure(c.TsdfConfig(), {**fields, "weighting": weighting, "edge_guard_rule": rule})
 
 
 def sample_points(g: Gen) -> Any:
@@ -2268,7 +2273,7 @@ def binding_targets() -> list[Target]:
             gen_tsdf,
             call_tsdf,
             garbage_tsdf,
-            ("Tsdf", "TsdfConfig", "TsdfWeighting", "PinholeCamera"),
+            ("Tsdf", "TsdfConfig", "TsdfWeighting", "TsdfEdgeGuardRule", "PinholeCamera"),
         ),
         Target(
             "Esdf",

@@ -138,6 +138,9 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "edge_guard_rad",
         "edge_guard_near_side_only",
         "edge_guard_grazing_voxels",
+        "edge_guard_rim_scale",
+        "grazing_reach_voxels",
+        "grazing_reach_max_voxels",
         "interpolate_depth",
         "carve_free_space",
         "no_return_carve_min_valid_fraction",
@@ -149,6 +152,8 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
     ):
         assert d[name] == pytest.approx(getattr(c, name)), name
     assert d["weighting"] == "constant"
+    assert d["edge_guard_rule"] == "rim_distance"
+    assert c.edge_guard_rule == dp.TsdfEdgeGuardRule.RIM_DISTANCE
     assert (d["slice_min_z_m"], d["slice_max_z_m"]) == (0.05, 1.8)
     # The window's defaults: Tsdf.slice_window's (SliceWindow's in the core).
     assert (d["slice_window_m"], d["slice_max_cells"]) == (0.0, 4000000)

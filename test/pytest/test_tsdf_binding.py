@@ -223,6 +223,44 @@ def test_edge_guard_removes_ghosts() -> None:
     assert ghosts[0.0075].completeness > ghosts[0.0].completeness - 0.002
 
 
+def test_rim_distance_rule_and_grazing_reach_fill_the_corridor_without_ghosts() -> None:
+    # Issue 22, defect 4: the corridor on the voxel lattice (its wall shelf's top and a box face
+    # on planes of voxel centres, seen at grazing incidence) against the rule before it.
+    from downstream_perception.sim.scenes import accuracy_scene
+
+    cam = DepthCamera()
+    scene, poses = accuracy_scene("corridor", (0.0, 0.0, 0.0), 12)
+    depths = [cam.render(scene, pose) for pose in poses]
+    observed = observed_samples(scene, cam, poses, depths)
+    defaults = dp.TsdfConfig()
+    assert defaults.edge_guard_rule == dp.TsdfEdgeGuardRule.RIM_DISTANCE
+    assert (defaults.edge_guard_rim_scale, defaults.grazing_reach_voxels) == (1.0, 1.0)
+    assert defaults.grazing_reach_max_voxels == 16.0
+    before = dp.TsdfConfig()
+    before.edge_guard_rule = dp.TsdfEdgeGuardRule.FIXED_RADIUS
+    before.grazing_reach_voxels = 0.0
+    scores = {}
+    for name, config in (("rim", defaults), ("before", before)):
+        tsdf = dp.Tsdf(config)
+        for pose, depth in zip(poses, depths, strict=True):
+            tsdf.integrate_depth(depth, camera(cam), pose)
+        tsdf.update_mesh()
+        mesh = tsdf.mesh()
+        scores[name] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
+    assert scores["rim"].completeness > scores["before"].completeness + 0.004
+    assert scores["rim"].ghost_fraction <= scores["before"].ghost_fraction
+    assert scores["rim"].ghost_fraction < 0.0005
+    # Out-of-range settings are refused with the key's name.
+    for key, value in (
+        ("edge_guard_rim_scale", 0.0),
+        ("grazing_reach_voxels", -1.0),
+        ("grazing_reach_max_voxels", 0.5),
+    ):
+        bad = dp.TsdfConfig()
+        setattr(bad, key, value)
+        assert key in bad.validate()
+
+
 def test_carving_erases_a_box_that_moved_away() -> None:
     # The room's box is seen from one pose, then removed: with carving its faces go back to free
     # space (the wall behind it is seen through where it stood), without carving they stay.

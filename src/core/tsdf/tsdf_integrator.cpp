@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "downstream_perception/core/parallel/avx2_clones.h"
+#include "downstream_perception/core/tsdf/depth_rims.h"
 
 namespace downstream_perception {
 
@@ -63,7 +64,8 @@ class ObservationWeight {
   float operator()(float z, float sdf) const {
     const float w = inverse_square_ ? 1.0f / (z * z) : 1.0f;
     const float dropped = w * ((mu_ + sdf) * inv_dropoff_span_);
-    return dropoff_ & (sdf < -start_) ? dropped : w;
+    // Grazing reach updates deeper than mu, where the ramp would go negative: weight 0 there.
+    return dropoff_ & (sdf < -start_) ? std::max(0.0f, dropped) : w;
   }
 
  private:
@@ -71,8 +73,7 @@ class ObservationWeight {
   bool dropoff_;
   float start_;  ///< m behind the surface where the ramp starts
   float mu_;
-  /// 1 / (mu - start); only used with dropoff_, where mu > start. Both integrators skip
-  /// sdf < -mu first, so the ramp never goes negative.
+  /// 1 / (mu - start); only used with dropoff_, where mu > start.
   float inv_dropoff_span_;
 };
 
@@ -98,12 +99,17 @@ struct DepthFrame {
   /// when they change.
   std::vector<float> range_per_depth;
   PinholeCamera camera;  ///< the intrinsics range_per_depth was computed for
-  /// Pixels within edge_guard_rad of a depth discontinuity (markNearEdges): what lies behind
-  /// them is not known to be behind a surface. Empty when the guard is off.
+  /// kFixedRadius: pixels within edge_guard_rad of a depth discontinuity (markNearEdges): what
+  /// lies behind them is not known to be behind a surface.
   std::vector<std::uint8_t> near_edge;
-  /// Per pixel, how deep behind its surface (m) voxels are updated when it is near_edge
-  /// (guardDepths). Empty when the guard is off.
+  /// Per pixel, how deep behind its surface (m along the ray) voxels are updated (the edge
+  /// guard and the grazing reach); empty when both are off (mu everywhere).
   std::vector<float> allowed;
+  SeedDistances rim_distances;  ///< kRimDistance: every pixel's distance to the nearest rim
+  /// |cos(incidence)| per pixel (incidenceCosines; -1 unknown), when the rim distance rule or
+  /// the grazing reach needs it; empty otherwise.
+  std::vector<float> cosine;
+  std::vector<float> column_x;     ///< scratch of incidenceCosines
   std::vector<std::uint8_t> edge;  ///< scratch: the discontinuities' seeds
   std::vector<std::uint8_t> rows;  ///< scratch: the seeds dilated along rows
   std::vector<float> seed_depth;   ///< scratch: the seeds' depths, then their window minimum
@@ -211,20 +217,15 @@ DP_INTEGRATION_STEP void spreadOverNearSide(int w, int h, float jump, int radius
   for (std::size_t i = 0; i < n; ++i) out[i] = (seed[i] != inf) & (dep[i] <= seed[i] + jump);
 }
 
-/// The edge guard's mask f->near_edge. Two neighbouring pixels (along a row or a column) are a
-/// depth discontinuity when one is not a valid depth (NaN, +Inf) or their depths differ by more
-/// than `jump` (m) and they are not onOnePlane within jump / 2 (a surface seen at a grazing angle
-/// far away steps by more than mu from pixel to pixel, but continues its neighbours' plane: no
-/// rim there). near_side_only: the nearer pixel of a discontinuity (the valid one next to an
-/// invalid one) is a seed, spread by `radius` pixels only over pixels not more than `jump`
-/// farther (spreadOverNearSide); else both pixels are seeds, spread to every pixel within
-/// `radius` (the guard before issue 22's defect 4).
-DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, bool near_side_only,
-                                       DepthFrame* f) {
+/// The rims (seeds) of the edge guard, into f->edge. Two neighbouring pixels (along a row or a
+/// column) are a depth discontinuity when one is not a valid depth (NaN, +Inf) or their depths
+/// differ by more than `jump` (m) and they are not onOnePlane within jump / 2 (a surface seen at
+/// a grazing angle far away steps by more than mu from pixel to pixel, but continues its
+/// neighbours' plane: no rim there). near_side_only: the nearer pixel of a discontinuity (the
+/// valid one next to an invalid one) is a seed; else both valid pixels are.
+DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only, DepthFrame* f) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
   f->edge.assign(n, 0);
-  f->rows.resize(n);
-  f->near_edge.resize(n);
   const float* inv = f->inverse.data();
   const float* dep = f->depth.data();
   std::uint8_t* edge = f->edge.data();
@@ -254,6 +255,17 @@ DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, boo
       pair(static_cast<std::size_t>(v) * w + u, static_cast<std::size_t>(w), v > 0, v + 2 < h);
     }
   }
+}
+
+/// kFixedRadius: the guard's mask f->near_edge. The rims (markRims) spread by `radius` pixels:
+/// near_side_only, only over pixels not more than `jump` farther (spreadOverNearSide); else to
+/// every pixel within `radius` (the guard before issue 22's defect 4).
+DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, bool near_side_only,
+                                       DepthFrame* f) {
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  markRims(w, h, jump, near_side_only, f);
+  f->rows.resize(n);
+  f->near_edge.resize(n);
   if (near_side_only) {
     spreadOverNearSide(w, h, jump, radius, f);
   } else {
@@ -261,57 +273,41 @@ DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, boo
   }
 }
 
-/// How deep behind its surface (m) a guarded pixel still updates voxels, into f->allowed: a
-/// voxel divided by the cosine of the incidence angle (between the ray and the surface normal,
-/// estimated from the neighbours along the row and the column nearest in depth), at most
-/// `max_voxels` voxels; a voxel at the rim pixels themselves (the seeds in f->edge). At grazing
+/// kFixedRadius (or no guard): how deep behind its surface (m along the ray) each pixel updates
+/// voxels, into f->allowed. A guarded pixel (f->near_edge): a voxel divided by the cosine of the
+/// incidence angle (incidenceCosine), at most `max_voxels` voxels and mu; a voxel at the rim
+/// pixels themselves (the seeds in f->edge) and where the incidence is unknown. At grazing
 /// incidence a voxel just under the surface lies several voxels behind it along the ray; without
 /// this the faces seen edge-on next to an object's rim (a box top seen from a little above it) got
-/// no "inside" values at all and no surface.
-DP_INTEGRATION_STEP void guardDepths(const PinholeCamera& cam, float s, float jump,
+/// no "inside" values at all and no surface. Other pixels: the grazing reach (mu without it; with
+/// it f->cosine holds every pixel's incidence).
+DP_INTEGRATION_STEP void guardDepths(const PinholeCamera& cam, const RimAllowanceSettings& rs,
                                      float max_voxels, DepthFrame* f) {
   const int w = cam.width, h = cam.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
-  f->allowed.assign(n, s);
-  if (!(max_voxels > 1.0f)) return;
+  f->allowed.assign(n, rs.truncation);
+  const bool guard = !f->near_edge.empty();
   const float min_cos = 1.0f / max_voxels;
   const float* dep = f->depth.data();
   const float* inv = f->inverse.data();
-  const float inv_fx = static_cast<float>(1.0 / cam.fx), inv_fy = static_cast<float>(1.0 / cam.fy);
-  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  const auto ray = [&](int u, int v) {
-    return Eigen::Vector3f((static_cast<float>(u) - cx) * inv_fx,
-                           (static_cast<float>(v) - cy) * inv_fy, 1.0f);
-  };
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * w + u;
-      // Not at the rim itself (a seed): its ray is the one that leaves the object again.
-      if (!f->near_edge[i] || f->edge[i] || inv[i] == 0.0f) continue;
-      const Eigen::Vector3f p = ray(u, v) * dep[i];
-      // The tangent towards the neighbour (either side) nearest in depth, within `jump`.
-      const auto tangent = [&](int du, int dv, Eigen::Vector3f* t) {
-        float best = jump;
-        bool found = false;
-        for (const int sign : {-1, 1}) {
-          const int uu = u + sign * du, vv = v + sign * dv;
-          if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
-          const std::size_t j = static_cast<std::size_t>(vv) * w + uu;
-          const float diff = std::abs(dep[j] - dep[i]);
-          if (inv[j] == 0.0f || !(diff <= best)) continue;
-          best = diff;
-          *t = ray(uu, vv) * dep[j] - p;
-          found = true;
+      if (inv[i] == 0.0f) continue;
+      if (guard && f->near_edge[i]) {
+        // The rim itself (a seed): its ray is the one that leaves the object again.
+        if (f->edge[i] || !(max_voxels > 1.0f)) {
+          f->allowed[i] = rs.voxel;
+          continue;
         }
-        return found;
-      };
-      Eigen::Vector3f tu, tv;
-      if (!tangent(1, 0, &tu) || !tangent(0, 1, &tv)) continue;
-      const Eigen::Vector3f normal = tu.cross(tv);
-      const float norms = normal.norm() * p.norm();
-      if (!(norms > 0.0f)) continue;
-      const float cosine = std::abs(normal.dot(p)) / norms;
-      f->allowed[i] = s / std::max(cosine, min_cos);
+        const float cosine =
+            f->cosine.empty() ? incidenceCosine(cam, dep, inv, u, v, rs.jump) : f->cosine[i];
+        f->allowed[i] = cosine < 0.0f
+                            ? rs.voxel
+                            : std::min(rs.truncation, rs.voxel / std::max(cosine, min_cos));
+      } else if (!f->cosine.empty()) {
+        f->allowed[i] = grazingReach(f->cosine[i], rs);
+      }
     }
   }
 }
@@ -389,21 +385,43 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   }
   const int radius =
       static_cast<int>(std::ceil(c.edge_guard_rad * std::max(camera.fx, camera.fy) - 1e-9));
-  if (radius > 0) {
-    markNearEdges(w, h, static_cast<float>(c.truncation()), radius, c.edge_guard_near_side_only,
-                  &f);
-    guardDepths(camera, static_cast<float>(c.voxel_size_m), static_cast<float>(c.truncation()),
-                static_cast<float>(c.edge_guard_grazing_voxels), &f);
+  const float mu = static_cast<float>(c.truncation());
+  RimAllowanceSettings rs;
+  rs.voxel = static_cast<float>(c.voxel_size_m);
+  rs.truncation = mu;
+  rs.jump = mu;
+  rs.reach = static_cast<float>(c.grazing_reach_voxels * c.voxel_size_m);
+  rs.reach_max = std::max(mu, static_cast<float>(c.grazing_reach_max_voxels * c.voxel_size_m));
+  rs.rim_scale = static_cast<float>(c.edge_guard_rim_scale);
+  rs.fallback_radius_px = static_cast<float>(radius);
+  f.near_edge.clear();
+  const bool rim_rule = radius > 0 && c.edge_guard_rule == TsdfConfig::EdgeGuardRule::kRimDistance;
+  if (rim_rule || rs.reach > 0.0f) {
+    f.cosine.resize(n);
+    incidenceCosines(camera, f.depth.data(), f.inverse.data(), mu, &f.column_x, f.cosine.data());
   } else {
-    f.near_edge.clear();
+    f.cosine.clear();
+  }
+  if (rim_rule) {
+    markRims(w, h, mu, c.edge_guard_near_side_only, &f);
+    seedDistances(w, h, f.edge.data(), &f.rim_distances);
+    f.allowed.resize(n);
+    rimAllowances(f.depth.data(), f.inverse.data(), f.edge.data(), f.rim_distances, f.cosine.data(),
+                  n, static_cast<float>(1.0 / std::max(camera.fx, camera.fy)), rs,
+                  f.allowed.data());
+  } else if (radius > 0 || rs.reach > 0.0f) {
+    if (radius > 0) markNearEdges(w, h, mu, radius, c.edge_guard_near_side_only, &f);
+    guardDepths(camera, rs, static_cast<float>(c.edge_guard_grazing_voxels), &f);
+  } else {
     f.allowed.clear();
   }
 }
 
-/// Blocks the truncation band of the valid pixels passes through (with carve_free_space, the
-/// whole ray from the sensor, and the rays of +Inf pixels up to max_depth_m). Pixels are sampled
-/// every `stride` pixels, where a stride spans at most one voxel at the nearest depth of the
-/// frame (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the
+/// Blocks the truncation band of the valid pixels passes through, from mu in front of the
+/// surface to the pixel's allowance behind it (DepthFrame::allowed; mu without one; with
+/// carve_free_space from the sensor, and the rays of +Inf pixels up to max_depth_m). Pixels are
+/// sampled every `stride` pixels, where a stride spans at most one voxel at the nearest depth of
+/// the frame (so no surface patch a voxel wide is skipped); neighbouring samples mostly land in the
 /// same block, so a one-entry cache per sample along the ray skips most hash lookups. The
 /// blocks are listed in the order the image's rows first reach them, so consecutive blocks read
 /// nearby pixels (hash order would scatter the integration's pixel reads over the whole image).
@@ -431,6 +449,7 @@ DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
   };
   const bool carve = c.carve_free_space;
   const int samples = carve ? samplesFor(c.max_depth_m + mu) : samplesFor(2.0 * mu);
+  const bool has_allowed = !f.allowed.empty();
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Vector3d t = T.translation();
   const int w = camera.width, h = camera.height;
@@ -443,7 +462,8 @@ DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
   };
   for (int v = 0; v < h; v = next(v, h)) {
     for (int u = 0; u < w; u = next(u, w)) {
-      float d = f.depth[static_cast<std::size_t>(v) * w + u];
+      const std::size_t pixel = static_cast<std::size_t>(v) * w + u;
+      float d = f.depth[pixel];
       if (carve && d == std::numeric_limits<float>::infinity()) {
         d = static_cast<float>(c.max_depth_m - mu);  // no return: free up to max_depth_m
       }
@@ -453,11 +473,13 @@ DP_INTEGRATION_STEP std::vector<Eigen::Vector3i> bandBlocks(const DepthFrame& f,
       const double range = d * norm;
       const Eigen::Vector3d dir = R * (ray / norm);
       const double r0 = carve ? 0.0 : std::max(0.0, range - mu);
-      const int n = carve ? samplesFor(range + mu) : samples;
+      // +Inf pixels have the allowance mu (no valid depth).
+      const double end = range + (has_allowed ? f.allowed[pixel] : mu);
+      const int n = samplesFor(end - r0);
       if (n > static_cast<int>(last.size())) {
         last.resize(n, Eigen::Vector3i(std::numeric_limits<int>::min(), 0, 0));
       }
-      const double step = (range + mu - r0) / (n - 1);
+      const double step = (end - r0) / (n - 1);
       for (int k = 0; k < n; ++k) {
         const Eigen::Vector3i key = blockOfPoint(t + dir * (r0 + step * k), 1.0 / s);
         if (key == last[k]) continue;
@@ -546,17 +568,17 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
   const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
   const float cx = static_cast<float>(camera.cx) + 0.5f, cy = static_cast<float>(camera.cy) + 0.5f;
   const float min_z = static_cast<float>(c.min_depth_m), max_z = static_cast<float>(c.max_depth_m);
-  const float muf = static_cast<float>(mu), sf = static_cast<float>(s);
+  const float muf = static_cast<float>(mu);
   const float u_end = static_cast<float>(w), v_end = static_cast<float>(h);
   const bool interpolate = c.interpolate_depth;
   const ObservationWeight weight(c, muf);
   const float inv_mu = 1.0f / muf;
-  const bool guard = !frame.near_edge.empty();
+  // Per-pixel allowances behind the surface (edge guard, grazing reach), or mu everywhere.
+  const bool has_allowed = !frame.allowed.empty();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float* depth_px = frame.depth.data();
   const float* range_px = frame.range_per_depth.data();
   const float* inverse_px = frame.inverse.data();
-  const std::uint8_t* edge_px = frame.near_edge.data();
   const std::uint8_t* smooth_px = frame.smooth.data();
   // Pass 2's per-voxel pixel data. A row writes the nearest depth of all eight voxels and the
   // rest only for voxels in the band; the others keep an earlier row's finite values, which
@@ -564,7 +586,7 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
   alignas(32) float nearest[kTsdfBlockSide] = {}, range[kTsdfBlockSide] = {};
   alignas(32) float i00[kTsdfBlockSide] = {}, i10[kTsdfBlockSide] = {}, i01[kTsdfBlockSide] = {},
                     i11[kTsdfBlockSide] = {};
-  alignas(32) int flags[kTsdfBlockSide] = {};  // bit 0: interpolate, bit 1: near an edge
+  alignas(32) int flags[kTsdfBlockSide] = {};  // 1: interpolate
   alignas(32) float allowed[kTsdfBlockSide] = {};
   const float* allowed_px = frame.allowed.data();
   // The blocks are found (or allocated) first, so each block's integration can prefetch the
@@ -628,13 +650,16 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
         for (int x = 0; x < kTsdfBlockSide; ++x) {
           const std::size_t px = static_cast<std::size_t>(pixel[x]);
           nearest[x] = depth_px[px];
+          // The pixel's allowance behind its surface, for every voxel (pass 3 reads it for all
+          // eight): deeper voxels skip the loads below.
+          allowed[x] = has_allowed ? allowed_px[px] : muf;
           const float along_axis = nearest[x] - zc[x];
-          if (!(along_axis >= -muf - max_step)) continue;  // behind the band, or NaN
+          // Behind the band, or NaN (|sdf| >= |along_axis|: the ray is at least as long).
+          if (!(along_axis >= -allowed[x] - max_step)) continue;
           any_update = true;
           if (!(along_axis <= muf + max_step)) continue;  // in front: free space
           range[x] = range_px[px];
-          int flag = guard ? edge_px[px] << 1 : 0;
-          allowed[x] = guard ? allowed_px[px] : sf;
+          int flag = 0;
           if (interpolate) {
             const float* inv = inverse_px + cell[x];
             i00[x] = inv[0];
@@ -668,13 +693,12 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
           // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table.
           const float sdf = in_band ? (d - z_axis) * range[x] : muf;
           const bool update =
-              (along_axis >= -muf - max_step) &
+              (along_axis >= -allowed[x] - max_step) &
               !(no_return & (z_axis > max_z)) &  // no return: free only up to max_depth_m
-              !(in_band & (sdf < -muf)) &
-              // Behind an object's rim the ray may have left the object again: no evidence of
-              // "inside" deeper than the guard allows (a voxel, more at grazing incidence).
-              !(in_band & (sdf < -allowed[x]) & ((flags[x] & 2) != 0));
-          const float dn = std::min(1.0f, sdf * inv_mu);
+              // Not deeper than the pixel's allowance: mu, less next to a rim (the ray may have
+              // left the object again), more at grazing incidence (the grazing reach).
+              !(in_band & (sdf < -allowed[x]));
+          const float dn = std::max(-1.0f, std::min(1.0f, sdf * inv_mu));
           const float obs_w = weight(no_return ? z_axis : nearest[x], sdf);
           TsdfVoxel& voxel = row_voxels[x];
           const TsdfVoxel fused = map->fused(voxel, dn, obs_w);

@@ -7,6 +7,22 @@
 
 namespace downstream_perception {
 
+std::string TsdfConfig::inertSettings() const {
+  const TsdfConfig defaults;
+  std::ostringstream why;
+  if (edge_guard_rule == EdgeGuardRule::kRimDistance &&
+      edge_guard_grazing_voxels != defaults.edge_guard_grazing_voxels) {
+    why << "edge_guard_grazing_voxels " << edge_guard_grazing_voxels
+        << " has no effect with edge_guard_rule rim_distance (the rim distance sets every "
+           "pixel's depth); it applies with fixed_radius";
+  } else if (edge_guard_rule == EdgeGuardRule::kFixedRadius &&
+             edge_guard_rim_scale != defaults.edge_guard_rim_scale) {
+    why << "edge_guard_rim_scale " << edge_guard_rim_scale
+        << " has no effect with edge_guard_rule fixed_radius; it applies with rim_distance";
+  }
+  return why.str();
+}
+
 std::string TsdfConfig::validate() const {
   std::ostringstream why;
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
@@ -27,6 +43,15 @@ std::string TsdfConfig::validate() const {
     why << "min_weight must be finite and >= 0, got " << min_weight;
   } else if (!(std::isfinite(edge_guard_rad) && edge_guard_rad >= 0.0 && edge_guard_rad < 0.2)) {
     why << "edge_guard_rad must be in [0, 0.2) rad, got " << edge_guard_rad;
+  } else if (!(edge_guard_rim_scale > 0.0 && edge_guard_rim_scale <= 100.0)) {
+    why << "edge_guard_rim_scale must be in (0, 100], got " << edge_guard_rim_scale;
+  } else if (!(grazing_reach_voxels >= 0.0 && grazing_reach_voxels <= 64.0)) {
+    why << "grazing_reach_voxels must be in [0, 64], got " << grazing_reach_voxels;
+  } else if (!(grazing_reach_max_voxels >= 1.0 && grazing_reach_max_voxels <= 256.0)) {
+    why << "grazing_reach_max_voxels must be in [1, 256], got " << grazing_reach_max_voxels;
+  } else if (edge_guard_rule != EdgeGuardRule::kRimDistance &&
+             edge_guard_rule != EdgeGuardRule::kFixedRadius) {
+    why << "edge_guard_rule must be rim_distance or fixed_radius";
   } else if (!(edge_guard_grazing_voxels >= 1.0 && edge_guard_grazing_voxels <= 1000.0)) {
     why << "edge_guard_grazing_voxels must be in [1, 1000], got " << edge_guard_grazing_voxels;
   } else if (!(std::isfinite(behind_surface_dropoff_start_voxels) &&

@@ -3,16 +3,25 @@
 #include <cmath>
 #include <cstddef>
 
+#include <ros/console.h>
+
 #include "downstream_perception/ros/common/param_reader.h"
 
 namespace downstream_perception {
 
-std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c) {
+std::string setNamedTsdfSettings(const std::string& weighting, const std::string& edge_guard_rule,
+                                 int max_blocks, TsdfConfig* c) {
   if (max_blocks < 1) return "max_blocks must be >= 1, got " + std::to_string(max_blocks);
   if (weighting != "constant" && weighting != "inverse_square_depth") {
     return "weighting must be 'constant' or 'inverse_square_depth', got '" + weighting + "'";
   }
+  if (edge_guard_rule != "rim_distance" && edge_guard_rule != "fixed_radius") {
+    return "edge_guard_rule must be 'rim_distance' or 'fixed_radius', got '" + edge_guard_rule +
+           "'";
+  }
   c->max_blocks = static_cast<std::size_t>(max_blocks);
+  c->edge_guard_rule = edge_guard_rule == "rim_distance" ? TsdfConfig::EdgeGuardRule::kRimDistance
+                                                         : TsdfConfig::EdgeGuardRule::kFixedRadius;
   c->weighting = weighting == "constant" ? TsdfConfig::Weighting::kConstant
                                          : TsdfConfig::Weighting::kInverseSquareDepth;
   return {};
@@ -33,6 +42,9 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   readParam(pnh, "edge_guard_rad", &c.edge_guard_rad, errors);
   readParam(pnh, "edge_guard_near_side_only", &c.edge_guard_near_side_only, errors);
   readParam(pnh, "edge_guard_grazing_voxels", &c.edge_guard_grazing_voxels, errors);
+  readParam(pnh, "edge_guard_rim_scale", &c.edge_guard_rim_scale, errors);
+  readParam(pnh, "grazing_reach_voxels", &c.grazing_reach_voxels, errors);
+  readParam(pnh, "grazing_reach_max_voxels", &c.grazing_reach_max_voxels, errors);
   readParam(pnh, "min_depth_m", &c.min_depth_m, errors);
   readParam(pnh, "max_depth_m", &c.max_depth_m, errors);
   readParam(pnh, "min_weight", &c.min_weight, errors);
@@ -41,10 +53,16 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   readParam(pnh, "max_blocks", &max_blocks, errors);
   std::string weighting = "constant";
   readParam(pnh, "weighting", &weighting, errors);
+  std::string edge_guard_rule = "rim_distance";
+  readParam(pnh, "edge_guard_rule", &edge_guard_rule, errors);
 
-  std::string why = setNamedTsdfSettings(weighting, max_blocks, &c);
+  std::string why = setNamedTsdfSettings(weighting, edge_guard_rule, max_blocks, &c);
   if (why.empty()) why = c.validate();
-  if (why.empty()) return c;
+  if (why.empty()) {
+    const std::string inert = c.inertSettings();
+    if (!inert.empty()) ROS_WARN_STREAM(pnh.getNamespace() << ": " << inert);
+    return c;
+  }
   errors->add("invalid TSDF parameters (" + why + "); using the defaults");
   return TsdfConfig{};
 }

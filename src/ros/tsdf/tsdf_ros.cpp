@@ -142,6 +142,9 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.edge_guard_rad = cfg.edge_guard_rad;
   next.edge_guard_near_side_only = cfg.edge_guard_near_side_only;
   next.edge_guard_grazing_voxels = cfg.edge_guard_grazing_voxels;
+  next.edge_guard_rim_scale = cfg.edge_guard_rim_scale;
+  next.grazing_reach_voxels = cfg.grazing_reach_voxels;
+  next.grazing_reach_max_voxels = cfg.grazing_reach_max_voxels;
   next.interpolate_depth = cfg.interpolate_depth;
   next.carve_free_space = cfg.carve_free_space;
   next.no_return_carve_min_valid_fraction = cfg.no_return_carve_min_valid_fraction;
@@ -149,7 +152,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.max_depth_m = cfg.max_depth_m;
   next.min_weight = cfg.min_weight;
   next.max_block_distance_m = cfg.max_block_distance_m;
-  std::string why = setNamedTsdfSettings(cfg.weighting, cfg.max_blocks, &next);
+  std::string why = setNamedTsdfSettings(cfg.weighting, cfg.edge_guard_rule, cfg.max_blocks, &next);
   TsdfSliceConfig next_slice = slice;
   next_slice.min_z_m = cfg.slice_min_z_m;
   next_slice.max_z_m = cfg.slice_max_z_m;
@@ -181,6 +184,8 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   if (!why.empty())
     config_errors_.add("live TSDF parameters refused (" + why + "); keeping the previous");
   if (octree_) octree_->setMaxDistance(now.max_block_distance_m);  // valid: the map took it
+  if (why.empty() && !now.inertSettings().empty())
+    ROS_WARN("tsdf: %s", now.inertSettings().c_str());
   if (!slice_why.empty()) {
     config_errors_.add("live slice band refused (" + slice_why + "); keeping [" +
                        toText(slice.min_z_m) + ", " + toText(slice.max_z_m) + "] m");

@@ -47,26 +47,51 @@ struct TsdfConfig {
   /// default before issue 22); later starts land between that and no ramp (docs/tsdf.md). A value
   /// >= truncation_voxels means no ramp (like behind_surface_dropoff false).
   double behind_surface_dropoff_start_voxels = 1.0;
-  /// Depth images: voxels more than a voxel behind the surface seen by a pixel within this angle
-  /// (rad) of a depth edge are not updated. Rays grazing an object's rim would otherwise write
-  /// "inside" values into the free space beyond its edges (the projective TSDF's ghost
-  /// surfaces). A depth edge: neighbouring pixels more than mu apart in depth (or one invalid)
-  /// that do not continue one plane (a surface seen at a grazing angle far away steps by more
-  /// than mu per pixel without an edge). 0.0075 rad is 2 pixels at f = 262, 4 at f = 525;
-  /// 0 disables.
+  /// Depth images: how far behind the surface a pixel next to a depth edge (an object's rim)
+  /// writes "inside" values. Rays grazing a rim would otherwise write them into the free space
+  /// beyond the object's edges (the projective TSDF's ghost surfaces). A depth edge: neighbouring
+  /// pixels more than mu apart in depth (or one invalid) that do not continue one plane (a
+  /// surface seen at a grazing angle far away steps by more than mu per pixel without an edge).
+  enum class EdgeGuardRule {
+    /// Each pixel's depth allowance follows from its distance to the nearest rim and its
+    /// incidence angle (depth_rims.h: how far its ray can travel before it may leave the object
+    /// through the face behind that rim), times edge_guard_rim_scale (issue 22's defect 4).
+    kRimDistance,
+    /// Pixels within edge_guard_rad of a rim update at most a voxel behind the surface (more at
+    /// grazing incidence: edge_guard_grazing_voxels), the others mu (the rule before issue 22's
+    /// defect 4).
+    kFixedRadius
+  };
+  EdgeGuardRule edge_guard_rule = EdgeGuardRule::kRimDistance;
+  /// 0 disables the edge guard. kFixedRadius: pixels within this angle (rad) of a depth edge are
+  /// guarded. kRimDistance: pixels without an incidence estimate (no neighbour within mu in depth
+  /// along a row or a column) within this angle of a rim update a voxel deep, others mu.
+  /// 0.0075 rad is 2 pixels at f = 262, 4 at f = 525.
   double edge_guard_rad = 0.0075;
-  /// Edge guard: only the nearer side of a depth edge (the object's rim) is guarded, and only
-  /// pixels at most mu farther than the rim; the background beside an object is behind a
-  /// surface like any other. false: both sides and every pixel within edge_guard_rad (the guard
-  /// before issue 22's defect 4: it cost surface seen only next to objects).
+  /// Edge guard: only the nearer side of a depth edge (the object's rim) is a rim, and (with
+  /// kFixedRadius) guarded pixels are those at most mu farther than it; the background beside an
+  /// object is behind a surface like any other. false: both sides (the guard before issue 22's
+  /// defect 4: it cost surface seen only next to objects).
   bool edge_guard_near_side_only = true;
-  /// Edge guard: a guarded pixel other than the rim pixels themselves still updates voxels up to
-  /// voxel_size_m / cos(incidence) behind its surface (incidence: between the ray and the surface
-  /// normal estimated from the neighbouring pixels), at most this many voxels. At grazing incidence
-  /// a voxel just under the surface lies several voxels behind it along the ray, so a face seen
-  /// edge-on next to a rim (a box top seen from a little above) got no surface. 1 = a voxel at any
-  /// incidence.
+  /// kRimDistance: scales the depth a pixel's distance from the rim allows (1 = the geometric
+  /// estimate; larger fills more surface next to rims and lets more ghosts through: 1.25 was a
+  /// little more complete on the simulated scenes, but on real PrimeSense frames it raised the
+  /// p95 depth residual from 25 to 28 mm; docs/tsdf.md).
+  double edge_guard_rim_scale = 1.0;
+  /// kFixedRadius only: a guarded pixel other than the rim pixels themselves still updates
+  /// voxels up to voxel_size_m / cos(incidence) behind its surface (incidence: between the ray
+  /// and the surface normal estimated from the neighbouring pixels), at most this many voxels.
+  /// 1 = a voxel at any incidence.
   double edge_guard_grazing_voxels = 2.0;
+  /// Depth images: every pixel writes "inside" values down to this many voxels below its surface
+  /// (along the normal: that / cos(incidence) along the ray), even beyond mu, at most
+  /// grazing_reach_max_voxels along the ray. At grazing incidence the voxel just under a surface
+  /// lies several voxels behind it along the ray, beyond mu: without it a shelf top seen from
+  /// just above got no zero crossing on some lattice phases. 0 = off (mu along the ray).
+  double grazing_reach_voxels = 1.0;
+  /// Cap (voxels along the ray) of grazing_reach_voxels; below truncation_voxels it acts as
+  /// truncation_voxels. Bounds the blocks a frame touches behind its surfaces.
+  double grazing_reach_max_voxels = 16.0;
   /// Depth images: read each voxel's depth by interpolating inverse depth between the four
   /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
   /// nearest pixel across depth edges (neighbours differing by more than one voxel).
@@ -100,6 +125,10 @@ struct TsdfConfig {
   double truncation() const { return truncation_voxels * voxel_size_m; }
   /// Empty if valid, else the reason.
   std::string validate() const;
+  /// Settings that differ from their defaults but have no effect under the chosen
+  /// edge_guard_rule (edge_guard_grazing_voxels with kRimDistance, edge_guard_rim_scale with
+  /// kFixedRadius), named with the reason; empty if none. The nodelet warns with it.
+  std::string inertSettings() const;
 };
 
 struct TsdfVoxel {

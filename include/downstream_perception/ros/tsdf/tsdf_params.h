@@ -19,10 +19,11 @@ namespace downstream_perception {
 /// a map is never built from half-valid settings.
 TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors);
 
-/// The two settings whose parameter type differs from the field's (the weighting by name, the
-/// block cap as an int), checked and stored into `c`. Empty on success, else the reason (and `c`
-/// keeps its values). Shared by the start-up parameters and dynamic_reconfigure.
-std::string setNamedTsdfSettings(const std::string& weighting, int max_blocks, TsdfConfig* c);
+/// The settings whose parameter type differs from the field's (the weighting and the edge guard's
+/// rule by name, the block cap as an int), checked and stored into `c`. Empty on success, else the
+/// reason (and `c` keeps its values). Shared by the start-up parameters and dynamic_reconfigure.
+std::string setNamedTsdfSettings(const std::string& weighting, const std::string& edge_guard_rule,
+                                 int max_blocks, TsdfConfig* c);
 
 /// The nodelet's own settings beside the map's TsdfConfig (~mesh_rate_hz, ~health_period_s, the
 /// slice, its window, ~tf_queue_size). Each invalid value is added to `errors` and its default

@@ -1,0 +1,83 @@
+// How deep behind its surface each pixel of a depth image may write "inside" values: the rim
+// distance rule of the TSDF integrator (issue 22, defect 4), and the pieces it is made of.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace downstream_perception {
+
+struct PinholeCamera;
+
+/// Per-pixel squared distance (px^2) to the nearest seed and that seed's index (-1: no seed in
+/// the image), from an exact Euclidean distance transform (Felzenszwalb and Huttenlocher's lower
+/// envelope of parabolas; the nearest seed in each column first, by sweeping rows, then the
+/// envelope along each row: O(pixels), all reads contiguous). Written by seedDistances; the
+/// scratch vectors are reused from call to call.
+struct SeedDistances {
+  std::vector<float> squared;                 ///< px^2; kNoSeed where the image has no seed
+  std::vector<std::int32_t> seed;             ///< row-major index of the nearest seed, -1 if none
+  std::vector<float> column_squared;          ///< scratch: squared distance within the column
+  std::vector<std::int32_t> column_seed_row;  ///< scratch: that seed's row (-1: none)
+  std::vector<std::int32_t> hull;    ///< scratch: one row's lower envelope (parabola apexes)
+  std::vector<std::int64_t> hull_f;  ///< scratch: their heights plus apex^2
+  static constexpr float kNoSeed = 1e30f;
+};
+
+/// Fills `out` for a w x h image whose seeds are the nonzero bytes of `seeds`. Ties between
+/// equally near seeds go to either (both are as near).
+void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out);
+
+/// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
+/// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when
+/// either direction has no such neighbour (a far grazing surface stepping by more than jump per
+/// pixel) or the surface is degenerate. depth: m (NaN where not
+/// valid); inverse: 1 / depth, 0 where not a valid depth.
+float incidenceCosine(const PinholeCamera& camera, const float* depth, const float* inverse, int u,
+                      int v, float jump);
+
+/// Settings of rimAllowances, all lengths in metres.
+struct RimAllowanceSettings {
+  float voxel = 0.0f;       ///< voxel size
+  float truncation = 0.0f;  ///< mu: the depth every pixel away from rims reaches
+  float jump = 0.0f;        ///< a rim's depth step (mu): a pixel farther than its seed by more
+                            ///< is the background beside the object, not the object
+  /// Grazing reach: every pixel reaches this deep below its surface (along the normal, so
+  /// reach / cos(incidence) along the ray), beyond mu if need be; 0 = off (mu along the ray).
+  float reach = 0.0f;
+  float reach_max = 0.0f;  ///< cap along the ray (>= mu where reach > 0)
+  float rim_scale = 1.0f;  ///< scales the depth the rim distance allows
+  /// Pixels without an incidence estimate within this many pixels of a seed reach one voxel
+  /// (the fixed-radius guard's rule); beyond it mu.
+  float fallback_radius_px = 0.0f;
+};
+
+/// incidenceCosine for every pixel of the image, into `cosine` (w * h): the interior rows
+/// branch-free (vectorised), the border pixels one at a time. column_x: scratch, reused.
+void incidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
+                      float jump, std::vector<float>* column_x, float* cosine);
+/// The interior pixels of incidenceCosines (not the image's first and last rows and columns);
+/// xs[u] = (u - cx) / fx.
+void incidenceCosinesInterior(const PinholeCamera& camera, const float* depth, const float* inverse,
+                              float jump, const float* xs, float* cosine);
+
+/// How deep behind its surface (m along the ray) each pixel writes "inside" values, into
+/// `allowed` (`pixels` of them; pixels without a valid depth get mu). Rim seeds (the nearer
+/// pixel of a depth discontinuity): one voxel. Other pixels: the ray through a pixel D pixels
+/// from the nearest rim on its side, entering a surface at incidence theta, travels about
+/// D * z * metres_per_px / (cos(theta) * sin(theta)) before it can leave the object through the
+/// face behind that rim (z: depth; metres_per_px: 1 / the larger focal length); deeper than that
+/// its "inside" is a guess that made ghosts. So allowed = min(reach_depth, max(voxel,
+/// rim_scale * that)), where reach_depth = grazingReach(cos(theta)). Where the incidence is
+/// unknown (cosine < 0): a voxel within fallback_radius_px of a rim, else mu. cosine: from
+/// incidenceCosines.
+void rimAllowances(const float* depth, const float* inverse, const std::uint8_t* seeds,
+                   const SeedDistances& distances, const float* cosine, std::size_t pixels,
+                   float metres_per_px, const RimAllowanceSettings& settings, float* allowed);
+
+/// The grazing reach alone (no rims) at |cos(incidence)| `cosine`: min(reach_max, max(mu,
+/// reach / cosine)); mu where the incidence is unknown (cosine <= 0) or reach is 0.
+float grazingReach(float cosine, const RimAllowanceSettings& settings);
+
+}  // namespace downstream_perception
