@@ -14,7 +14,8 @@ namespace downstream_perception {
 // Both passes read memory contiguously: the vertical nearest seed by sweeping whole rows (down,
 // then up), the exact transform by the lower envelope of parabolas along each row.
 DP_AVX2_CLONES
-void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out) {
+void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
+                   float max_distance_px) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
   const float none = SeedDistances::kNoSeed;
   out->squared.resize(n);
@@ -57,12 +58,15 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out) 
   // the loop's dependency chain).
   std::int32_t* hull = out->hull.data();
   std::int64_t* hull_f = out->hull_f.data();
+  // Parabolas whose apex lies max_distance_px or more above the row cannot bring a pixel nearer
+  // than that: left out (most of them, far from the rims).
+  const float max_squared = max_distance_px * max_distance_px;
   for (int v = 0; v < h; ++v) {
     const std::size_t row = static_cast<std::size_t>(v) * w;
     const float* g = out->column_squared.data() + row;
     int top = -1;
     for (int q = 0; q < w; ++q) {
-      if (g[q] >= none) continue;
+      if (!(g[q] < max_squared) || g[q] >= none) continue;
       const std::int64_t fq = static_cast<std::int64_t>(g[q]) + static_cast<std::int64_t>(q) * q;
       // Pop the top parabola while q's overtakes it no later than it overtook the one below:
       // (fq - fp) / 2(q - p) <= (fp - fpp) / 2(p - pp).

@@ -61,6 +61,16 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
         EXPECT_EQ((su - u) * (su - u) + (sv - v) * (sv - v), best);
       }
     }
+    // Bounded to 5 px: exact nearer than that, at least that (or no seed) beyond.
+    SeedDistances bounded;
+    seedDistances(w, h, seeds.data(), &bounded, 5.0f);
+    for (std::size_t i = 0; i < seeds.size(); ++i) {
+      if (out.squared[i] < 25.0f) {
+        EXPECT_EQ(bounded.squared[i], out.squared[i]);
+      } else {
+        EXPECT_GE(bounded.squared[i], 25.0f);
+      }
+    }
   }
 }
 

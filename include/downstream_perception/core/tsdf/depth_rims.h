@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace downstream_perception {
@@ -26,8 +27,11 @@ struct SeedDistances {
 };
 
 /// Fills `out` for a w x h image whose seeds are the nonzero bytes of `seeds`. Ties between
-/// equally near seeds go to either (both are as near).
-void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out);
+/// equally near seeds go to either (both are as near). Exact for every pixel nearer than
+/// max_distance_px to a seed; a pixel farther from every seed gets a distance >= it, or kNoSeed
+/// and -1 (the search leaves out what cannot come nearer). Infinity: exact everywhere.
+void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
+                   float max_distance_px = std::numeric_limits<float>::infinity());
 
 /// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
 /// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when
