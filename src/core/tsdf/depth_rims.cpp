@@ -49,8 +49,8 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
       const bool take_down = (down >= 0) & ((up < 0) | (down - v < v - up));
       const std::int32_t best = take_down ? down : up;
       row_of[row + u] = best;
-      const float dv = static_cast<float>(v - best);
-      out->column_squared[row + u] = best < 0 ? none : dv * dv;
+      const std::int32_t dv = v - best;
+      out->column_squared[row + u] = best < 0 ? -1 : dv * dv;  // < 2^31: h <= 16384 px
     }
   }
   // Along each row: the lower envelope of the parabolas (u - q)^2 + column_squared(q), with its
@@ -60,14 +60,14 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
   std::int64_t* hull_f = out->hull_f.data();
   // Parabolas whose apex lies max_distance_px or more above the row cannot bring a pixel nearer
   // than that: left out (most of them, far from the rims).
-  const float max_squared = max_distance_px * max_distance_px;
+  const double max_squared = static_cast<double>(max_distance_px) * max_distance_px;
   for (int v = 0; v < h; ++v) {
     const std::size_t row = static_cast<std::size_t>(v) * w;
-    const float* g = out->column_squared.data() + row;
+    const std::int32_t* g = out->column_squared.data() + row;
     int top = -1;
     for (int q = 0; q < w; ++q) {
-      if (!(g[q] < max_squared) || g[q] >= none) continue;
-      const std::int64_t fq = static_cast<std::int64_t>(g[q]) + static_cast<std::int64_t>(q) * q;
+      if (g[q] < 0 || !(g[q] < max_squared)) continue;
+      const std::int64_t fq = g[q] + static_cast<std::int64_t>(q) * q;
       // Pop the top parabola while q's overtakes it no later than it overtook the one below:
       // (fq - fp) / 2(q - p) <= (fp - fpp) / 2(p - pp).
       while (top >= 1) {
@@ -93,8 +93,8 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
         ++k;
       }
       const int q = hull[k];
-      const float du = static_cast<float>(u - q);
-      out->squared[row + u] = du * du + g[q];
+      const std::int64_t du = u - q;
+      out->squared[row + u] = static_cast<float>(du * du + g[q]);
       out->seed[row + u] = row_of[row + q] * w + q;
     }
   }

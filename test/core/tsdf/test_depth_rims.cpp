@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -70,6 +71,34 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
       } else {
         EXPECT_GE(bounded.squared[i], 25.0f);
       }
+    }
+  }
+}
+
+TEST(DepthRims, SeedDistancesStayExactAcrossTheLargestImages) {
+  // 16384 px across (the largest PinholeCamera allows), 3 rows: squared distances up to
+  // 2.7e8 px^2, beyond float's integers; the envelope compares them in 64-bit integers.
+  const int w = 16384, h = 3;
+  std::vector<std::uint8_t> seeds(static_cast<std::size_t>(w) * h, 0);
+  seeds[0] = 1;                                        // (0, 0)
+  seeds[static_cast<std::size_t>(2) * w + w - 1] = 1;  // (16383, 2)
+  seeds[static_cast<std::size_t>(1) * w + 8191] = 1;   // (8191, 1)
+  SeedDistances out;
+  seedDistances(w, h, seeds.data(), &out);
+  for (const int v : {0, 1, 2}) {
+    for (const int u : {1, 4095, 4096, 6000, 8190, 12287, 12288, 16382}) {
+      long best = -1;
+      int best_seed = -1;
+      for (const auto& [su, sv] : std::vector<std::array<int, 2>>{{0, 0}, {8191, 1}, {16383, 2}}) {
+        const long d2 = static_cast<long>(su - u) * (su - u) + static_cast<long>(sv - v) * (sv - v);
+        if (best < 0 || d2 < best) {
+          best = d2;
+          best_seed = sv * w + su;
+        }
+      }
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      EXPECT_EQ(out.squared[i], static_cast<float>(best)) << u << "," << v;
+      EXPECT_EQ(out.seed[i], best_seed) << u << "," << v;
     }
   }
 }

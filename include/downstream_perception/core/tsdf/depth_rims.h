@@ -19,7 +19,7 @@ struct PinholeCamera;
 struct SeedDistances {
   std::vector<float> squared;                 ///< px^2; kNoSeed where the image has no seed
   std::vector<std::int32_t> seed;             ///< row-major index of the nearest seed, -1 if none
-  std::vector<float> column_squared;          ///< scratch: squared distance within the column
+  std::vector<std::int32_t> column_squared;   ///< scratch: squared distance in the column, -1 none
   std::vector<std::int32_t> column_seed_row;  ///< scratch: that seed's row (-1: none)
   std::vector<std::int32_t> hull;    ///< scratch: one row's lower envelope (parabola apexes)
   std::vector<std::int64_t> hull_f;  ///< scratch: their heights plus apex^2
