@@ -297,12 +297,7 @@ double shelfTopCovered(const TsdfConfig& c, std::size_t* ghosts) {
   const auto scene = [](const Eigen::Vector3d& p) {
     return std::min({p.z(), p.y() + 1.2, boxSdf(p, {7.0, -0.9, 0.9}, {0.25, 0.3, 0.02})});
   };
-  PinholeCamera camera;  // the benchmark's 320 x 240 camera
-  camera.width = 320;
-  camera.height = 240;
-  camera.fx = camera.fy = 262.5;
-  camera.cx = 159.5;
-  camera.cy = 119.5;
+  const PinholeCamera camera = benchmarkCamera();
   TsdfMap map(c);
   DepthIntegrator integrator;
   std::vector<Eigen::Isometry3d> poses;
@@ -323,16 +318,7 @@ double shelfTopCovered(const TsdfConfig& c, std::size_t* ghosts) {
   for (double x = 6.77; x <= 7.23; x += 0.02) {
     for (double y = -1.18; y <= -0.62; y += 0.02) {
       const Eigen::Vector3d p(x, y, 0.92);
-      bool visible = false;
-      for (std::size_t k = 0; k < poses.size() && !visible; ++k) {
-        const Eigen::Vector3d q = poses[k].inverse() * p;
-        const int u = static_cast<int>(std::lround(camera.fx * q.x() / q.z() + camera.cx));
-        const int v = static_cast<int>(std::lround(camera.fy * q.y() / q.z() + camera.cy));
-        if (q.z() <= 0.0 || u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
-        visible =
-            std::abs(depths[k][static_cast<std::size_t>(v) * camera.width + u] - q.z()) < 0.01;
-      }
-      if (!visible) continue;
+      if (!seenBySomeFrame(camera, poses, depths, p)) continue;
       ++seen;
       bool near = false;
       for (const Eigen::Vector3f& v : mesh.vertices) {

@@ -22,6 +22,7 @@
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "esdf_test_helpers.h"
 #include "tsdf_test_helpers.h"
+#include "tsdf_test_scenes.h"
 
 using namespace downstream_perception;        // NOLINT
 using namespace downstream_perception::test;  // NOLINT
@@ -448,12 +449,7 @@ struct CorridorScore {
 };
 
 CorridorScore scoreCorridor(const TsdfConfig& c) {
-  PinholeCamera camera;  // the benchmark's 320 x 240 camera
-  camera.width = 320;
-  camera.height = 240;
-  camera.fx = camera.fy = 262.5;
-  camera.cx = 159.5;
-  camera.cy = 119.5;
+  const PinholeCamera camera = benchmarkCamera();
   TsdfMap map(c);
   DepthIntegrator integrator;
   std::vector<Eigen::Isometry3d> poses;
@@ -484,16 +480,7 @@ CorridorScore scoreCorridor(const TsdfConfig& c) {
   for (double x = 6.0; x <= 8.5; x += 0.05) {
     for (double y = -0.6; y <= 0.6; y += 0.05) {
       const Eigen::Vector3d p = Eigen::Vector3d(x, y, 0.0) + kCorridorShift;
-      bool visible = false;
-      for (std::size_t k = 0; k < poses.size() && !visible; ++k) {
-        const Eigen::Vector3d q = poses[k].inverse() * p;
-        const int u = static_cast<int>(std::lround(camera.fx * q.x() / q.z() + camera.cx));
-        const int v = static_cast<int>(std::lround(camera.fy * q.y() / q.z() + camera.cy));
-        if (q.z() <= 0.0 || u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
-        visible =
-            std::abs(depths[k][static_cast<std::size_t>(v) * camera.width + u] - q.z()) < 0.01;
-      }
-      if (!visible) continue;
+      if (!seenBySomeFrame(camera, poses, depths, p)) continue;
       ++seen;
       const Eigen::Vector3i cell = (p / s).array().round().cast<int>();
       bool near = false;
