@@ -14,8 +14,9 @@ struct PinholeCamera;
 /// Per-pixel squared distance (px^2) to the nearest seed and that seed's index (-1: no seed in
 /// the image), from an exact Euclidean distance transform (Felzenszwalb and Huttenlocher's lower
 /// envelope of parabolas; the nearest seed in each column first, by sweeping rows, then the
-/// envelope along each row: O(pixels), all reads contiguous). Written by seedDistances; the
-/// scratch vectors are reused from call to call.
+/// envelope along each row: O(pixels), all reads contiguous). Its own because the rule needs
+/// the nearest seed itself, which the inflation's and the ESDF's transforms (distances only) do
+/// not give. Written by seedDistances; the scratch vectors are reused from call to call.
 struct SeedDistances {
   std::vector<float> squared;                 ///< px^2; kNoSeed where the image has no seed
   std::vector<std::int32_t> seed;             ///< row-major index of the nearest seed, -1 if none
