@@ -15,58 +15,59 @@ namespace downstream_perception {
 // then up), the exact transform by the lower envelope of parabolas along each row.
 DP_AVX2_CLONES
 void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
-                   float max_distance_px) {
+                   float max_distance_px, const float* values) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
   const float none = SeedDistances::kNoSeed;
   out->squared.resize(n);
   out->seed.resize(n);
-  out->column_squared.resize(n);
+  if (values != nullptr) out->seed_value.resize(n);
   out->column_seed_row.resize(n);
+  out->column_squared.resize(static_cast<std::size_t>(w));
   out->hull.resize(static_cast<std::size_t>(w));
   out->hull_f.resize(static_cast<std::size_t>(w));
   // The nearest seed in the same column: above (sweeping down), then the nearer of that and the
-  // one below (sweeping up). -1: none.
+  // one below (sweeping up, the nearest below carried in a row-long scratch). -1: none.
   std::int32_t* row_of = out->column_seed_row.data();
-  for (int v = 0; v < h; ++v) {
+  for (int u = 0; u < w; ++u) row_of[u] = seeds[u] ? 0 : -1;
+  for (int v = 1; v < h; ++v) {
     const std::size_t row = static_cast<std::size_t>(v) * w;
-    for (int u = 0; u < w; ++u) {
-      const std::int32_t above = v > 0 ? row_of[row - w + u] : -1;
-      row_of[row + u] = seeds[row + u] ? v : above;
-    }
+    for (int u = 0; u < w; ++u) row_of[row + u] = seeds[row + u] ? v : row_of[row - w + u];
   }
-  std::int32_t* below = out->seed.data();  // scratch until the row pass writes the result
+  std::int32_t* below = out->column_squared.data();  // scratch until the row pass
+  std::fill(below, below + w, -1);
   for (int v = h - 1; v >= 0; --v) {
     const std::size_t row = static_cast<std::size_t>(v) * w;
     for (int u = 0; u < w; ++u) {
-      const std::int32_t next = v + 1 < h ? below[row + w + u] : -1;
-      below[row + u] = seeds[row + u] ? v : next;
-    }
-  }
-  for (int v = 0; v < h; ++v) {
-    const std::size_t row = static_cast<std::size_t>(v) * w;
-    for (int u = 0; u < w; ++u) {
-      const std::int32_t up = row_of[row + u], down = below[row + u];
+      const std::int32_t down = seeds[row + u] ? v : below[u];
+      below[u] = down;
+      const std::int32_t up = row_of[row + u];
       const bool take_down = (down >= 0) & ((up < 0) | (down - v < v - up));
-      const std::int32_t best = take_down ? down : up;
-      row_of[row + u] = best;
-      const std::int32_t dv = v - best;
-      out->column_squared[row + u] = best < 0 ? -1 : dv * dv;  // < 2^31: h <= 16384 px
+      row_of[row + u] = take_down ? down : up;
     }
   }
-  // Along each row: the lower envelope of the parabolas (u - q)^2 + column_squared(q), with its
-  // intersections compared by cross-multiplying in 64-bit integers (exact, and no division in
-  // the loop's dependency chain).
+  // Along each row: the lower envelope of the parabolas (u - q)^2 + g(q), g the squared
+  // distance to q's nearest seed in its column, with its intersections compared by
+  // cross-multiplying in 64-bit integers (exact, and no division in the loop's dependency chain).
+  std::int32_t* g = out->column_squared.data();
   std::int32_t* hull = out->hull.data();
   std::int64_t* hull_f = out->hull_f.data();
   // Parabolas whose apex lies max_distance_px or more above the row cannot bring a pixel nearer
   // than that: left out (most of them, far from the rims).
   const double max_squared = static_cast<double>(max_distance_px) * max_distance_px;
+  const std::int32_t limit = max_squared < 2147483647.0
+                                 ? static_cast<std::int32_t>(std::ceil(max_squared))
+                                 : std::numeric_limits<std::int32_t>::max();
   for (int v = 0; v < h; ++v) {
     const std::size_t row = static_cast<std::size_t>(v) * w;
-    const std::int32_t* g = out->column_squared.data() + row;
+    const std::int32_t* seed_row = row_of + row;
+    for (int u = 0; u < w; ++u) {
+      const std::int32_t dv = v - seed_row[u];
+      const std::int32_t squared = dv * dv;  // < 2^31: h <= 16384 px
+      g[u] = (seed_row[u] < 0) | (squared >= limit) ? -1 : squared;
+    }
     int top = -1;
     for (int q = 0; q < w; ++q) {
-      if (g[q] < 0 || !(g[q] < max_squared)) continue;
+      if (g[q] < 0) continue;
       const std::int64_t fq = g[q] + static_cast<std::int64_t>(q) * q;
       // Pop the top parabola while q's overtakes it no later than it overtook the one below:
       // (fq - fp) / 2(q - p) <= (fp - fpp) / 2(p - pp).
@@ -80,22 +81,40 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
       hull[top] = q;
       hull_f[top] = fq;
     }
-    int k = 0;
-    for (int u = 0; u < w; ++u) {
-      if (top < 0) {
-        out->squared[row + u] = none;
-        out->seed[row + u] = -1;
-        continue;
-      }
-      // Next parabola while it is at least as low at u: (f1 - f0) <= 2 u (h1 - h0).
-      while (k < top && hull_f[k + 1] - hull_f[k] <=
-                            2 * static_cast<std::int64_t>(u) * (hull[k + 1] - hull[k])) {
-        ++k;
+    float* squared_out = out->squared.data() + row;
+    std::int32_t* seed_out = out->seed.data() + row;
+    float* value_out = values != nullptr ? out->seed_value.data() + row : nullptr;
+    if (top < 0) {
+      std::fill(squared_out, squared_out + w, none);
+      std::fill(seed_out, seed_out + w, -1);
+      if (value_out != nullptr) std::fill(value_out, value_out + w, none);
+      continue;
+    }
+    // Each envelope parabola's run of pixels, filled in one go (no per-pixel branch): parabola
+    // k + 1 is at least as low from the first u with (f1 - f0) <= 2 u (h1 - h0); the quotient in
+    // double, then made exact by the integer test.
+    int u = 0;
+    for (int k = 0; k <= top; ++k) {
+      int end = w;
+      if (k < top) {
+        const std::int64_t df = hull_f[k + 1] - hull_f[k];
+        const std::int64_t dh = 2 * static_cast<std::int64_t>(hull[k + 1] - hull[k]);
+        auto first =
+            static_cast<std::int64_t>(std::ceil(static_cast<double>(df) / static_cast<double>(dh)));
+        while (df <= (first - 1) * dh) --first;
+        while (df > first * dh) ++first;
+        end = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(first, u), w));
       }
       const int q = hull[k];
-      const std::int64_t du = u - q;
-      out->squared[row + u] = static_cast<float>(du * du + g[q]);
-      out->seed[row + u] = row_of[row + q] * w + q;
+      const std::int64_t gq = g[q];
+      const std::int32_t nearest = seed_row[q] * w + q;
+      for (int x = u; x < end; ++x) {
+        const std::int64_t du = x - q;
+        squared_out[x] = static_cast<float>(du * du + gq);
+        seed_out[x] = nearest;
+      }
+      if (value_out != nullptr) std::fill(value_out + u, value_out + end, values[nearest]);
+      u = end;
     }
   }
 }
@@ -220,31 +239,35 @@ void rimAllowances(const float* depth, const float* inverse, const std::uint8_t*
                    const SeedDistances& distances, const float* cosine, std::size_t pixels,
                    float metres_per_px, const RimAllowanceSettings& s, float* allowed) {
   const float fallback_squared = s.fallback_radius_px * s.fallback_radius_px;
-  const std::int32_t* seed_of = distances.seed.data();
   const float* squared_px = distances.squared.data();
-  // The squared rim distance where the nearest rim counts: only if this pixel is on its object
-  // (not the background beside it, more than jump farther). A loop of its own: the seed's depth
-  // is a gather, the loop below then vectorises.
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const std::int32_t seed = seed_of[i];
-    const float seed_depth = depth[seed >= 0 ? static_cast<std::size_t>(seed) : i];
-    const bool near_rim = (seed >= 0) & (depth[i] <= seed_depth + s.jump);
-    allowed[i] = near_rim ? squared_px[i] : SeedDistances::kNoSeed;
+  // The nearest rim's depth: from seedDistances' values when it was given the depths (no
+  // gather), else gathered here.
+  const float* seed_depth = distances.seed_value.data();
+  if (distances.seed_value.size() < pixels) {
+    const std::int32_t* seed_of = distances.seed.data();
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const std::int32_t seed = seed_of[i];
+      allowed[i] = seed >= 0 ? depth[seed] : SeedDistances::kNoSeed;
+    }
+    seed_depth = allowed;  // read before written below, pixel by pixel
   }
   // The settings in locals: the stores below could otherwise alias them for the compiler.
   const float voxel = s.voxel, mu = s.truncation, reach_per_cos = s.reach, reach_max = s.reach_max;
+  const float jump = s.jump;
   const float scale = s.rim_scale * metres_per_px;
   const bool reaching = s.reach > 0.0f;
   for (std::size_t i = 0; i < pixels; ++i) {
-    const float squared = allowed[i];
-    const bool near_rim = squared < SeedDistances::kNoSeed;
+    const float squared = squared_px[i];
+    // The nearest rim counts only if this pixel is on its object (not the background beside
+    // it, more than jump farther).
+    const bool near_rim = (squared < SeedDistances::kNoSeed) & (depth[i] <= seed_depth[i] + jump);
     const float c = cosine[i];
     const float reach =
         reaching & (c > 0.0f) ? std::min(reach_max, std::max(mu, reach_per_cos / c)) : mu;
     const float sine = std::sqrt(std::max(0.0f, 1.0f - c * c));
     const float travel = scale * std::sqrt(squared) * depth[i] / std::max(c * sine, 1e-6f);
     float a = near_rim ? std::min(reach, std::max(voxel, travel)) : reach;
-    a = c < 0.0f ? (squared <= fallback_squared ? voxel : mu) : a;
+    a = c < 0.0f ? (near_rim & (squared <= fallback_squared) ? voxel : mu) : a;
     a = seeds[i] != 0 ? voxel : a;
     allowed[i] = inverse[i] != 0.0f ? a : mu;
   }

@@ -404,14 +404,17 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   }
   if (rim_rule) {
     markRims(w, h, mu, c.edge_guard_near_side_only, &f);
-    // Beyond this distance from its rim no pixel is bound by it (rimAllowances: D z / (f cos
-    // sin) >= B / (cos sin) >= its grazing reach, B = max(mu, reach) at the frame's nearest
-    // depth); the transform need not look farther.
+    // Beyond this distance from its rim no pixel is bound by it, so the transform need not look
+    // farther: bound means D z / (f c s) < reach(c) = min(reach_max, max(mu, r / c)), so
+    // D < f s max(mu c, r) / z <= f max(mu / 2, r) / z (c s = sin(2 theta) / 2 <= 1/2, s <= 1),
+    // largest at the frame's nearest depth (D: px from the rim; c, s: cos and sin of the
+    // incidence; r: the grazing reach; rim_scale divides).
     const double focal = std::max(camera.fx, camera.fy);
-    const double bound = std::max(static_cast<double>(mu), static_cast<double>(rs.reach));
+    const double bound = std::max(0.5 * static_cast<double>(mu), static_cast<double>(rs.reach));
     const double beyond = bound * focal / (c.edge_guard_rim_scale * f.min_depth) + 1.0;
     seedDistances(w, h, f.edge.data(), &f.rim_distances,
-                  static_cast<float>(std::max(beyond, rs.fallback_radius_px + 1.0)));
+                  static_cast<float>(std::max(beyond, rs.fallback_radius_px + 1.0)),
+                  f.depth.data());
     f.allowed.resize(n);
     rimAllowances(f.depth.data(), f.inverse.data(), f.edge.data(), f.rim_distances, f.cosine.data(),
                   n, static_cast<float>(1.0 / std::max(camera.fx, camera.fy)), rs,

@@ -36,7 +36,9 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
     std::bernoulli_distribution seed(density);
     std::vector<std::uint8_t> seeds(static_cast<std::size_t>(w) * h);
     for (auto& s : seeds) s = seed(rng);
-    seedDistances(w, h, seeds.data(), &out);
+    std::vector<float> values(seeds.size());
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.5f + static_cast<float>(i);
+    seedDistances(w, h, seeds.data(), &out, std::numeric_limits<float>::infinity(), values.data());
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
         long best = -1;
@@ -51,6 +53,7 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
         if (best < 0) {
           EXPECT_EQ(out.seed[i], -1);
           EXPECT_EQ(out.squared[i], SeedDistances::kNoSeed);
+          EXPECT_EQ(out.seed_value[i], SeedDistances::kNoSeed);
           continue;
         }
         ASSERT_EQ(out.squared[i], static_cast<float>(best))
@@ -58,6 +61,7 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
         const int s = out.seed[i];
         ASSERT_GE(s, 0);
         ASSERT_TRUE(seeds[static_cast<std::size_t>(s)]);
+        EXPECT_EQ(out.seed_value[i], values[static_cast<std::size_t>(s)]);  // the seed's value
         const int su = s % w, sv = s / w;
         EXPECT_EQ((su - u) * (su - u) + (sv - v) * (sv - v), best);
       }
@@ -271,19 +275,26 @@ TEST(DepthRims, TheBackgroundBesideAnObjectIsNotBoundByItsRim) {
       seeds[i] = u == 79;
     }
   }
-  SeedDistances distances;
-  seedDistances(w, h, seeds.data(), &distances);
   RimAllowanceSettings s = twoCentimetreSettings();
   s.rim_scale = 0.01f;  // so the rim binds wherever it counts
-  std::vector<float> allowed(depth.size()), cosine(depth.size()), xs;
+  std::vector<float> cosine(depth.size()), xs;
   incidenceCosines(camera, depth.data(), inverse.data(), s.jump, &xs, cosine.data());
-  rimAllowances(depth.data(), inverse.data(), seeds.data(), distances, cosine.data(),
-                allowed.size(), 1.0f / 150.0f, s, allowed.data());
-  const std::size_t row = 60 * static_cast<std::size_t>(w);
-  EXPECT_FLOAT_EQ(allowed[row + 79], 0.02f);  // the rim
-  EXPECT_FLOAT_EQ(allowed[row + 77], 0.02f);  // the board next to it: bound to a voxel
-  EXPECT_FLOAT_EQ(allowed[row + 81], 0.08f);  // the wall beside: mu, not bound
-  EXPECT_FLOAT_EQ(allowed[row + 100], 0.08f);
+  // The rims' depths from the transform (what the integrator passes) or gathered by
+  // rimAllowances itself: the same allowances.
+  for (const bool with_depths : {true, false}) {
+    SeedDistances distances;
+    seedDistances(w, h, seeds.data(), &distances, std::numeric_limits<float>::infinity(),
+                  with_depths ? depth.data() : nullptr);
+    EXPECT_EQ(distances.seed_value.empty(), !with_depths);
+    std::vector<float> allowed(depth.size());
+    rimAllowances(depth.data(), inverse.data(), seeds.data(), distances, cosine.data(),
+                  allowed.size(), 1.0f / 150.0f, s, allowed.data());
+    const std::size_t row = 60 * static_cast<std::size_t>(w);
+    EXPECT_FLOAT_EQ(allowed[row + 79], 0.02f);  // the rim
+    EXPECT_FLOAT_EQ(allowed[row + 77], 0.02f);  // the board next to it: bound to a voxel
+    EXPECT_FLOAT_EQ(allowed[row + 81], 0.08f);  // the wall beside: mu, not bound
+    EXPECT_FLOAT_EQ(allowed[row + 100], 0.08f);
+  }
 }
 
 namespace {

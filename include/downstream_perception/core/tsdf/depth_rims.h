@@ -20,8 +20,9 @@ struct PinholeCamera;
 struct SeedDistances {
   std::vector<float> squared;                 ///< px^2; kNoSeed where the image has no seed
   std::vector<std::int32_t> seed;             ///< row-major index of the nearest seed, -1 if none
-  std::vector<std::int32_t> column_squared;   ///< scratch: squared distance in the column, -1 none
-  std::vector<std::int32_t> column_seed_row;  ///< scratch: that seed's row (-1: none)
+  std::vector<float> seed_value;              ///< values[seed] when seedDistances was given values
+  std::vector<std::int32_t> column_seed_row;  ///< scratch: the nearest seed's row in the column
+  std::vector<std::int32_t> column_squared;   ///< scratch: one row's squared column distances
   std::vector<std::int32_t> hull;    ///< scratch: one row's lower envelope (parabola apexes)
   std::vector<std::int64_t> hull_f;  ///< scratch: their heights plus apex^2
   static constexpr float kNoSeed = 1e30f;
@@ -30,9 +31,12 @@ struct SeedDistances {
 /// Fills `out` for a w x h image whose seeds are the nonzero bytes of `seeds`. Ties between
 /// equally near seeds go to either (both are as near). Exact for every pixel nearer than
 /// max_distance_px to a seed; a pixel farther from every seed gets a distance >= it, or kNoSeed
-/// and -1 (the search leaves out what cannot come nearer). Infinity: exact everywhere.
+/// and -1 (the search leaves out what cannot come nearer). Infinity: exact everywhere. With
+/// `values` (w * h), also out->seed_value = values at the nearest seed (kNoSeed without one):
+/// written run by run, so callers need no gather.
 void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
-                   float max_distance_px = std::numeric_limits<float>::infinity());
+                   float max_distance_px = std::numeric_limits<float>::infinity(),
+                   const float* values = nullptr);
 
 /// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
 /// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when
