@@ -15,12 +15,13 @@ namespace downstream_perception {
 // then up), the exact transform by the lower envelope of parabolas along each row.
 DP_AVX2_CLONES
 void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
-                   float max_distance_px, const float* values) {
+                   float max_distance_px, std::initializer_list<const float*> planes) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
   const float none = SeedDistances::kNoSeed;
   out->squared.resize(n);
   out->seed.resize(n);
-  if (values != nullptr) out->seed_value.resize(n);
+  out->seed_values.resize(planes.size());
+  for (auto& values : out->seed_values) values.resize(n);
   out->column_seed_row.resize(n);
   out->column_squared.resize(static_cast<std::size_t>(w));
   out->hull.resize(static_cast<std::size_t>(w));
@@ -83,11 +84,11 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
     }
     float* squared_out = out->squared.data() + row;
     std::int32_t* seed_out = out->seed.data() + row;
-    float* value_out = values != nullptr ? out->seed_value.data() + row : nullptr;
     if (top < 0) {
       std::fill(squared_out, squared_out + w, none);
       std::fill(seed_out, seed_out + w, -1);
-      if (value_out != nullptr) std::fill(value_out, value_out + w, none);
+      for (auto& values : out->seed_values)
+        std::fill(values.data() + row, values.data() + row + w, none);
       continue;
     }
     // Each envelope parabola's run of pixels, filled in one go (no per-pixel branch): parabola
@@ -113,7 +114,11 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
         squared_out[x] = static_cast<float>(du * du + gq);
         seed_out[x] = nearest;
       }
-      if (value_out != nullptr) std::fill(value_out + u, value_out + end, values[nearest]);
+      std::size_t plane = 0;
+      for (const float* values : planes) {
+        float* value_out = out->seed_values[plane++].data() + row;
+        std::fill(value_out + u, value_out + end, values[nearest]);
+      }
       u = end;
     }
   }
@@ -236,36 +241,52 @@ float grazingReach(float cosine, const RimAllowanceSettings& s) {
 
 DP_AVX2_CLONES
 void rimAllowances(const float* depth, const float* inverse, const std::uint8_t* seeds,
-                   const SeedDistances& distances, const float* cosine, std::size_t pixels,
+                   SeedDistances* distances, const float* cosine, std::size_t pixels,
                    float metres_per_px, const RimAllowanceSettings& s, float* allowed) {
-  const float fallback_squared = s.fallback_radius_px * s.fallback_radius_px;
-  const float* squared_px = distances.squared.data();
-  // The nearest rim's depth: from seedDistances' values when it was given the depths (no
-  // gather), else gathered here.
-  const float* seed_depth = distances.seed_value.data();
-  if (distances.seed_value.size() < pixels) {
-    const std::int32_t* seed_of = distances.seed.data();
+  // The nearest rim's depth and incidence: from seedDistances when it was given those planes
+  // (no gather), else gathered here.
+  auto& planes = distances->seed_values;
+  if (planes.size() != 2 || planes[0].size() < pixels || planes[1].size() < pixels) {
+    planes.assign(2, std::vector<float>(pixels, SeedDistances::kNoSeed));
     for (std::size_t i = 0; i < pixels; ++i) {
-      const std::int32_t seed = seed_of[i];
-      allowed[i] = seed >= 0 ? depth[seed] : SeedDistances::kNoSeed;
+      const std::int32_t seed = distances->seed[i];
+      if (seed < 0) continue;
+      planes[0][i] = depth[seed];
+      planes[1][i] = cosine[seed];
     }
-    seed_depth = allowed;  // read before written below, pixel by pixel
   }
+  const float* squared_px = distances->squared.data();
+  const float* rim_depth = planes[0].data();
+  const float* rim_cosine = planes[1].data();
+  const float fallback_squared = s.fallback_radius_px * s.fallback_radius_px;
   // The settings in locals: the stores below could otherwise alias them for the compiler.
   const float voxel = s.voxel, mu = s.truncation, reach_per_cos = s.reach, reach_max = s.reach_max;
   const float jump = s.jump;
   const float scale = s.rim_scale * metres_per_px;
+  const float radians_per_px = s.radians_per_px;
+  const float margin = kSilhouetteSineMargin;
   const bool reaching = s.reach > 0.0f;
   for (std::size_t i = 0; i < pixels; ++i) {
     const float squared = squared_px[i];
     // The nearest rim counts only if this pixel is on its object (not the background beside
     // it, more than jump farther).
-    const bool near_rim = (squared < SeedDistances::kNoSeed) & (depth[i] <= seed_depth[i] + jump);
+    const bool near_rim = (squared < SeedDistances::kNoSeed) & (depth[i] <= rim_depth[i] + jump);
     const float c = cosine[i];
     const float reach =
         reaching & (c > 0.0f) ? std::min(reach_max, std::max(mu, reach_per_cos / c)) : mu;
     const float sine = std::sqrt(std::max(0.0f, 1.0f - c * c));
-    const float travel = scale * std::sqrt(squared) * depth[i] / std::max(c * sine, 1e-6f);
+    // A rim seen more grazing than the pixel (unknown incidence: grazing) ends a surface that
+    // turns towards the line of sight: the silhouette of a convex surface, behind which the ray
+    // leaves no earlier than at the silhouette's depth, sine (1 + sine) times the plane's travel
+    // (a sphere: half its chord 2 r cos against r (1 - sine) / (cos sine); issue 22). On a plane
+    // the incidences of two pixels differ by at most the angle between their rays (D px apart:
+    // D radians_per_px), so only a rim more grazing than that (and the estimate's noise) turns.
+    const float distance_px = std::sqrt(squared);
+    const float rc = rim_cosine[i];
+    const float rim_sine = rc < 0.0f ? 1.0f : std::sqrt(std::max(0.0f, 1.0f - rc * rc));
+    const bool turning = near_rim & (rim_sine > sine + distance_px * radians_per_px + margin);
+    const float factor = turning ? std::max(1.0f, sine * (1.0f + sine)) : 1.0f;
+    const float travel = factor * scale * distance_px * depth[i] / std::max(c * sine, 1e-6f);
     float a = near_rim ? std::min(reach, std::max(voxel, travel)) : reach;
     a = c < 0.0f ? (near_rim & (squared <= fallback_squared) ? voxel : mu) : a;
     a = seeds[i] != 0 ? voxel : a;

@@ -394,6 +394,7 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   rs.reach_max = std::max(mu, static_cast<float>(c.grazing_reach_max_voxels * c.voxel_size_m));
   rs.rim_scale = static_cast<float>(c.edge_guard_rim_scale);
   rs.fallback_radius_px = static_cast<float>(radius);
+  rs.radians_per_px = static_cast<float>(1.0 / std::min(camera.fx, camera.fy));
   f.near_edge.clear();
   const bool rim_rule = radius > 0 && c.edge_guard_rule == TsdfConfig::EdgeGuardRule::kRimDistance;
   if (rim_rule || rs.reach > 0.0f) {
@@ -408,16 +409,17 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
     // farther: bound means D z / (f c s) < reach(c) = min(reach_max, max(mu, r / c)), so
     // D < f s max(mu c, r) / z <= f max(mu / 2, r) / z (c s = sin(2 theta) / 2 <= 1/2, s <= 1),
     // largest at the frame's nearest depth (D: px from the rim; c, s: cos and sin of the
-    // incidence; r: the grazing reach; rim_scale divides).
+    // incidence; r: the grazing reach; rim_scale divides; the silhouette factor, >= 1, only
+    // lengthens the travel).
     const double focal = std::max(camera.fx, camera.fy);
     const double bound = std::max(0.5 * static_cast<double>(mu), static_cast<double>(rs.reach));
     const double beyond = bound * focal / (c.edge_guard_rim_scale * f.min_depth) + 1.0;
     seedDistances(w, h, f.edge.data(), &f.rim_distances,
                   static_cast<float>(std::max(beyond, rs.fallback_radius_px + 1.0)),
-                  f.depth.data());
+                  {f.depth.data(), f.cosine.data()});
     f.allowed.resize(n);
-    rimAllowances(f.depth.data(), f.inverse.data(), f.edge.data(), f.rim_distances, f.cosine.data(),
-                  n, static_cast<float>(1.0 / std::max(camera.fx, camera.fy)), rs,
+    rimAllowances(f.depth.data(), f.inverse.data(), f.edge.data(), &f.rim_distances,
+                  f.cosine.data(), n, static_cast<float>(1.0 / std::max(camera.fx, camera.fy)), rs,
                   f.allowed.data());
   } else if (radius > 0 || rs.reach > 0.0f) {
     if (radius > 0) markNearEdges(w, h, mu, radius, c.edge_guard_near_side_only, &f);

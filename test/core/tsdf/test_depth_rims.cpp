@@ -38,7 +38,8 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
     for (auto& s : seeds) s = seed(rng);
     std::vector<float> values(seeds.size());
     for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.5f + static_cast<float>(i);
-    seedDistances(w, h, seeds.data(), &out, std::numeric_limits<float>::infinity(), values.data());
+    seedDistances(w, h, seeds.data(), &out, std::numeric_limits<float>::infinity(),
+                  {values.data()});
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
         long best = -1;
@@ -53,7 +54,7 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
         if (best < 0) {
           EXPECT_EQ(out.seed[i], -1);
           EXPECT_EQ(out.squared[i], SeedDistances::kNoSeed);
-          EXPECT_EQ(out.seed_value[i], SeedDistances::kNoSeed);
+          EXPECT_EQ(out.seed_values[0][i], SeedDistances::kNoSeed);
           continue;
         }
         ASSERT_EQ(out.squared[i], static_cast<float>(best))
@@ -61,7 +62,7 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
         const int s = out.seed[i];
         ASSERT_GE(s, 0);
         ASSERT_TRUE(seeds[static_cast<std::size_t>(s)]);
-        EXPECT_EQ(out.seed_value[i], values[static_cast<std::size_t>(s)]);  // the seed's value
+        EXPECT_EQ(out.seed_values[0][i], values[static_cast<std::size_t>(s)]);  // the seed's value
         const int su = s % w, sv = s / w;
         EXPECT_EQ((su - u) * (su - u) + (sv - v) * (sv - v), best);
       }
@@ -147,6 +148,7 @@ RimAllowanceSettings twoCentimetreSettings() {
   s.reach_max = 0.32f;
   s.rim_scale = 1.5f;
   s.fallback_radius_px = 2.0f;
+  s.radians_per_px = 1.0f / 150.0f;  // smallCamera's
   return s;
 }
 
@@ -227,13 +229,15 @@ TEST(DepthRims, AllowanceFollowsTheRimDistanceAndTheIncidence) {
   const int w = floor.camera.width, h = floor.camera.height;
   SeedDistances distances;
   seedDistances(w, h, floor.seeds.data(), &distances);
-  for (const float scale : {1.5f, 0.2f}) {
+  // Scale 0.1: the rim binds 22 rows away too, where the floor's incidence cosine is 0.13 above
+  // the rim's (perspective, not a turning surface): still the plane's travel.
+  for (const float scale : {1.5f, 0.2f, 0.1f}) {
     RimAllowanceSettings s = twoCentimetreSettings();
     s.rim_scale = scale;
     std::vector<float> allowed(static_cast<std::size_t>(w) * h), cosine(allowed.size()), xs;
     incidenceCosines(floor.camera, floor.depth.data(), floor.inverse.data(), s.jump, &xs,
                      cosine.data());
-    rimAllowances(floor.depth.data(), floor.inverse.data(), floor.seeds.data(), distances,
+    rimAllowances(floor.depth.data(), floor.inverse.data(), floor.seeds.data(), &distances,
                   cosine.data(), allowed.size(), 1.0f / 150.0f, s, allowed.data());
     int rim_bound = 0;
     for (const int k : {2, 3, 4, 8, 15, 22}) {
@@ -260,6 +264,71 @@ TEST(DepthRims, AllowanceFollowsTheRimDistanceAndTheIncidence) {
   }
 }
 
+TEST(DepthRims, ASphereLetsItsRaysReachItsSilhouettesDepthButNotItsBack) {
+  // A ball (radius 0.4 m, 1.5 m ahead) against nothing: its silhouette is the rim. Along each
+  // pixel's ray the ball is a chord; the plane rule would stop the rays near the silhouette at
+  // about half of what reaches the silhouette's depth (half the chord). The silhouette factor
+  // lets them reach it, and no ray passes the ball's back.
+  const PinholeCamera camera = smallCamera();
+  const int w = camera.width, h = camera.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  const Eigen::Vector3d centre(0.0, 0.0, 1.5);
+  const double radius = 0.4;
+  std::vector<float> depth(n, std::nanf("")), inverse(n, 0.0f), chord(n, 0.0f);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const Eigen::Vector3d ray((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+      // |t ray - centre| = radius: t^2 |ray|^2 - 2 t ray.centre + |centre|^2 - radius^2 = 0.
+      const double a = ray.squaredNorm(), b = ray.dot(centre);
+      const double disc = b * b - a * (centre.squaredNorm() - radius * radius);
+      if (disc <= 0.0) continue;
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      depth[i] = static_cast<float>((b - std::sqrt(disc)) / a);
+      inverse[i] = 1.0f / depth[i];
+      chord[i] = static_cast<float>(2.0 * std::sqrt(disc) / a * std::sqrt(a));  // m along the ray
+    }
+  }
+  std::vector<std::uint8_t> seeds(n, 0);  // ball pixels beside a miss
+  for (int v = 1; v + 1 < h; ++v) {
+    for (int u = 1; u + 1 < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      seeds[i] = inverse[i] != 0.0f && (inverse[i - 1] == 0.0f || inverse[i + 1] == 0.0f ||
+                                        inverse[i - w] == 0.0f || inverse[i + w] == 0.0f);
+    }
+  }
+  RimAllowanceSettings s = twoCentimetreSettings();
+  s.rim_scale = 1.0f;
+  s.truncation = s.reach_max = 2.0f;  // so the rim alone bounds every ray
+  std::vector<float> cosine(n), xs, allowed(n);
+  incidenceCosines(camera, depth.data(), inverse.data(), s.jump, &xs, cosine.data());
+  SeedDistances distances;
+  seedDistances(w, h, seeds.data(), &distances, std::numeric_limits<float>::infinity(),
+                {depth.data(), cosine.data()});
+  rimAllowances(depth.data(), inverse.data(), seeds.data(), &distances, cosine.data(), n,
+                1.0f / 150.0f, s, allowed.data());
+  int checked = 0, near_silhouette = 0, reaching = 0, plane_reaching = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (inverse[i] == 0.0f || seeds[i] || cosine[i] < 0.0f) continue;
+    const float d = std::sqrt(distances.squared[i]);
+    if (d > 10.0f) continue;  // farther in, the rim stops binding (mu does, not tested here)
+    ++checked;
+    // Never past the ball's back (the voxel floor aside).
+    EXPECT_LE(allowed[i], std::max(chord[i] * 1.02f, s.voxel)) << i;
+    if (d < 3.0f || d > 8.0f) continue;  // 3-8 px inside the silhouette
+    ++near_silhouette;
+    const float c = cosine[i], sine = std::sqrt(1.0f - c * c);
+    const float plane = d * depth[i] / (150.0f * c * sine);
+    // Two thirds of the way: D counts from the rim pixel's centre, the silhouette lies up to a
+    // pixel beyond it (about 0.7-0.8 of the half chord is what the estimate gives here).
+    reaching += allowed[i] >= 0.65f * 0.5f * chord[i];
+    plane_reaching += plane >= 0.65f * 0.5f * chord[i];
+  }
+  EXPECT_GT(checked, 1000);
+  ASSERT_GT(near_silhouette, 500);
+  EXPECT_GT(reaching, near_silhouette * 9 / 10);    // nearly everywhere
+  EXPECT_LT(plane_reaching, near_silhouette / 10);  // where the plane rule fell short
+}
+
 TEST(DepthRims, TheBackgroundBesideAnObjectIsNotBoundByItsRim) {
   // A fronto-parallel board at 1 m over the left half, the wall at 3 m behind: the board's rim
   // (column 79) bounds the board's pixels, not the wall's (2 m farther than the rim).
@@ -279,15 +348,19 @@ TEST(DepthRims, TheBackgroundBesideAnObjectIsNotBoundByItsRim) {
   s.rim_scale = 0.01f;  // so the rim binds wherever it counts
   std::vector<float> cosine(depth.size()), xs;
   incidenceCosines(camera, depth.data(), inverse.data(), s.jump, &xs, cosine.data());
-  // The rims' depths from the transform (what the integrator passes) or gathered by
-  // rimAllowances itself: the same allowances.
-  for (const bool with_depths : {true, false}) {
+  // The rims' depths and incidences from the transform (what the integrator passes) or
+  // gathered by rimAllowances itself: the same allowances.
+  for (const bool with_planes : {true, false}) {
     SeedDistances distances;
-    seedDistances(w, h, seeds.data(), &distances, std::numeric_limits<float>::infinity(),
-                  with_depths ? depth.data() : nullptr);
-    EXPECT_EQ(distances.seed_value.empty(), !with_depths);
+    if (with_planes) {
+      seedDistances(w, h, seeds.data(), &distances, std::numeric_limits<float>::infinity(),
+                    {depth.data(), cosine.data()});
+    } else {
+      seedDistances(w, h, seeds.data(), &distances);
+    }
+    EXPECT_EQ(distances.seed_values.empty(), !with_planes);
     std::vector<float> allowed(depth.size());
-    rimAllowances(depth.data(), inverse.data(), seeds.data(), distances, cosine.data(),
+    rimAllowances(depth.data(), inverse.data(), seeds.data(), &distances, cosine.data(),
                   allowed.size(), 1.0f / 150.0f, s, allowed.data());
     const std::size_t row = 60 * static_cast<std::size_t>(w);
     EXPECT_FLOAT_EQ(allowed[row + 79], 0.02f);  // the rim
