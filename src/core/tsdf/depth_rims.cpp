@@ -267,11 +267,12 @@ void rimAllowances(const float* depth, const float* inverse, const std::uint8_t*
   const float margin = kSilhouetteSineMargin;
   const bool reaching = s.reach > 0.0f;
   for (std::size_t i = 0; i < pixels; ++i) {
-    const float squared = squared_px[i];
+    const float squared = squared_px[i], z = depth[i], c = cosine[i];
+    const float rim_z = rim_depth[i], rc = rim_cosine[i];
+    const bool is_seed = seeds[i] != 0, valid = inverse[i] != 0.0f;
     // The nearest rim counts only if this pixel is on its object (not the background beside
     // it, more than jump farther).
-    const bool near_rim = (squared < SeedDistances::kNoSeed) & (depth[i] <= rim_depth[i] + jump);
-    const float c = cosine[i];
+    const bool near_rim = (squared < SeedDistances::kNoSeed) & (z <= rim_z + jump);
     const float reach =
         reaching & (c > 0.0f) ? std::min(reach_max, std::max(mu, reach_per_cos / c)) : mu;
     const float sine = std::sqrt(std::max(0.0f, 1.0f - c * c));
@@ -282,15 +283,15 @@ void rimAllowances(const float* depth, const float* inverse, const std::uint8_t*
     // the incidences of two pixels differ by at most the angle between their rays (D px apart:
     // D radians_per_px), so only a rim more grazing than that (and the estimate's noise) turns.
     const float distance_px = std::sqrt(squared);
-    const float rc = rim_cosine[i];
     const float rim_sine = rc < 0.0f ? 1.0f : std::sqrt(std::max(0.0f, 1.0f - rc * rc));
-    const bool turning = near_rim & (rim_sine > sine + distance_px * radians_per_px + margin);
+    // (Only read where near_rim: and-ing it in here kept the AVX2 copy from vectorising.)
+    const bool turning = rim_sine > sine + distance_px * radians_per_px + margin;
     const float factor = turning ? std::max(1.0f, sine * (1.0f + sine)) : 1.0f;
-    const float travel = factor * scale * distance_px * depth[i] / std::max(c * sine, 1e-6f);
+    const float travel = factor * scale * distance_px * z / std::max(c * sine, 1e-6f);
     float a = near_rim ? std::min(reach, std::max(voxel, travel)) : reach;
     a = c < 0.0f ? (near_rim & (squared <= fallback_squared) ? voxel : mu) : a;
-    a = seeds[i] != 0 ? voxel : a;
-    allowed[i] = inverse[i] != 0.0f ? a : mu;
+    a = is_seed ? voxel : a;
+    allowed[i] = valid ? a : mu;
   }
 }
 
