@@ -419,8 +419,7 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
                   {f.depth.data(), f.cosine.data()});
     f.allowed.resize(n);
     rimAllowances(f.depth.data(), f.inverse.data(), f.edge.data(), &f.rim_distances,
-                  f.cosine.data(), n, static_cast<float>(1.0 / std::max(camera.fx, camera.fy)), rs,
-                  f.allowed.data());
+                  f.cosine.data(), n, static_cast<float>(1.0 / focal), rs, f.allowed.data());
   } else if (radius > 0 || rs.reach > 0.0f) {
     if (radius > 0) markNearEdges(w, h, mu, radius, c.edge_guard_near_side_only, &f);
     guardDepths(camera, rs, static_cast<float>(c.edge_guard_grazing_voxels), &f);
