@@ -58,6 +58,11 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
   const std::int32_t limit = max_squared < 2147483647.0
                                  ? static_cast<std::int32_t>(std::ceil(max_squared))
                                  : std::numeric_limits<std::int32_t>::max();
+  // The run fill's squared distances in 32-bit integers where they fit (its int-to-float
+  // conversion vectorises, the 64-bit one does not; both round the same value the same way):
+  // every g kept is below the limit and every |u - q| below w.
+  const bool fits_32 =
+      static_cast<std::int64_t>(w) * w + limit <= std::numeric_limits<std::int32_t>::max();
   for (int v = 0; v < h; ++v) {
     const std::size_t row = static_cast<std::size_t>(v) * w;
     const std::int32_t* seed_row = row_of + row;
@@ -107,12 +112,21 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
         end = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(first, u), w));
       }
       const int q = hull[k];
-      const std::int64_t gq = g[q];
       const std::int32_t nearest = seed_row[q] * w + q;
-      for (int x = u; x < end; ++x) {
-        const std::int64_t du = x - q;
-        squared_out[x] = static_cast<float>(du * du + gq);
-        seed_out[x] = nearest;
+      if (fits_32) {
+        const std::int32_t gq = g[q];
+        for (int x = u; x < end; ++x) {
+          const std::int32_t du = x - q;
+          squared_out[x] = static_cast<float>(du * du + gq);
+          seed_out[x] = nearest;
+        }
+      } else {
+        const std::int64_t gq = g[q];
+        for (int x = u; x < end; ++x) {
+          const std::int64_t du = x - q;
+          squared_out[x] = static_cast<float>(du * du + gq);
+          seed_out[x] = nearest;
+        }
       }
       std::size_t plane = 0;
       for (const float* values : planes) {

@@ -67,6 +67,12 @@ TEST(DepthRims, SeedDistancesEqualBruteForce) {
         EXPECT_EQ((su - u) * (su - u) + (sv - v) * (sv - v), best);
       }
     }
+    // Bounded beyond the image's diagonal: the same distances and seeds, the run fill then in
+    // 32-bit integers (the unbounded call above takes the 64-bit path).
+    SeedDistances wide;
+    seedDistances(w, h, seeds.data(), &wide, 1000.0f);
+    EXPECT_EQ(wide.squared, out.squared) << w << "x" << h;
+    EXPECT_EQ(wide.seed, out.seed) << w << "x" << h;
     // Bounded to 5 px: exact nearer than that, at least that (or no seed) beyond.
     SeedDistances bounded;
     seedDistances(w, h, seeds.data(), &bounded, 5.0f);
