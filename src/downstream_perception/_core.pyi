@@ -445,6 +445,13 @@ class TsdfConfig:
         self, arg0: typing.SupportsFloat | typing.SupportsIndex
     ) -> None: ...
     @property
+    def confirm_depth_voxels(self) -> float:
+        """
+        Depth images: a voxel only ever seen deeper than this many voxels behind a surface (along its normal) is unconfirmed: it fuses and the ESDF, slice and sample() read it, but the mesh leaves it out until a frame sees it nearer a surface or in front of one (a thin slab's unseen underside). 0 = off.
+        """
+    @confirm_depth_voxels.setter
+    def confirm_depth_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
     def carve_free_space(self) -> bool:
         """
         Update the voxels along the whole ray from the sensor, not only the truncation band: an object that moved away is erased where its free space is seen again (voxblox's voxel carving). Off by default: it allocates blocks for all the free space in view, so memory and time grow with the range. Carving stays inside the camera's view frustum up to max_depth_m (PinholeCamera::validate refuses intrinsics whose frustum is absurdly wide or off-axis).

@@ -236,6 +236,12 @@ void bindTsdf(py::module& m) {
                      "With behind_surface_dropoff, the weight stays 1 up to this many voxels "
                      "behind the surface, then falls linearly to 0 at -mu (1 = voxblox's ramp; "
                      ">= truncation_voxels = no ramp).")
+      .def_readwrite("confirm_depth_voxels", &TsdfConfig::confirm_depth_voxels,
+                     "Depth images: a voxel only ever seen deeper than this many voxels behind a "
+                     "surface (along its normal) is unconfirmed: it fuses and the ESDF, slice "
+                     "and sample() read it, but the mesh leaves it out until a frame sees it "
+                     "nearer a surface or in front of one (a thin slab's unseen underside). "
+                     "0 = off.")
       .def_readwrite("edge_guard_rule", &TsdfConfig::edge_guard_rule,
                      "Depth images: how deep behind the surface pixels next to a depth edge (an "
                      "object's rim) write inside values (rays grazing a rim would otherwise "
@@ -402,9 +408,9 @@ void bindTsdf(py::module& m) {
             for (py::ssize_t i = 0; i < n; ++i) {
               // Far or NaN points have no voxel (NaN, weight 0), not a clamped index's.
               const TsdfVoxel* v = self.map.voxelNear(points.row(i).transpose());
-              const bool known = v != nullptr && v->weight > self.map.config().min_weight;
+              const bool known = v != nullptr && v->observedWeight() > self.map.config().min_weight;
               distance.mutable_at(i) = known ? v->distance * mu : std::nan("");
-              weight.mutable_at(i) = v == nullptr ? 0.0 : v->weight;
+              weight.mutable_at(i) = v == nullptr ? 0.0 : v->observedWeight();
             }
             return py::make_tuple(distance, weight);
           },

@@ -135,6 +135,7 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "max_weight",
         "behind_surface_dropoff",
         "behind_surface_dropoff_start_voxels",
+        "confirm_depth_voxels",
         "edge_guard_rad",
         "edge_guard_near_side_only",
         "edge_guard_grazing_voxels",

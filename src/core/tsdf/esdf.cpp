@@ -71,7 +71,7 @@ std::string EsdfConfig::validate(double voxel_size_m) const {
 }
 
 EsdfState esdfStateOf(const TsdfVoxel& v, float min_weight) {
-  if (!(v.weight > min_weight)) return EsdfState::kUnknown;
+  if (!(v.observedWeight() > min_weight)) return EsdfState::kUnknown;
   return v.distance < 0.0f ? EsdfState::kOccupied : EsdfState::kFree;
 }
 

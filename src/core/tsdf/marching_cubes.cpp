@@ -161,6 +161,7 @@ bool gather(const TsdfMap& map, const Eigen::Vector3i& block, float min_weight, 
   const auto observedDistance = [&](const TsdfBlock* b, int x, int y, int z) {
     if (b == nullptr) return missing;
     const TsdfVoxel& v = b->voxels[TsdfBlock::linear(x, y, z)];
+    // An unconfirmed voxel (TsdfConfig::confirm_depth_voxels) has a negative weight: missing.
     return v.weight > min_weight ? v.distance : missing;
   };
   // Row by row (x = -1 .. 9): one voxel from the block on the left, the centre block's eight

@@ -25,7 +25,7 @@ TsdfHealth tsdfHealth(const TsdfMap& map) {
   const auto inside = [tie](float d) { return d < -tie; };
   const auto value = [&](const Eigen::Vector3i& v, float* d) {
     const TsdfVoxel* voxel = map.voxel(v);
-    if (voxel == nullptr || !(voxel->weight > min_weight)) return false;
+    if (voxel == nullptr || !(voxel->observedWeight() > min_weight)) return false;
     *d = voxel->distance;
     return true;
   };
@@ -36,7 +36,7 @@ TsdfHealth tsdfHealth(const TsdfMap& map) {
       for (int y = 0; y < kTsdfBlockSide; ++y) {
         for (int x = 0; x < kTsdfBlockSide; ++x) {
           const TsdfVoxel& here = block->voxels[TsdfBlock::linear(x, y, z)];
-          if (!(here.weight > min_weight)) continue;
+          if (!(here.observedWeight() > min_weight)) continue;
           const Eigen::Vector3i v = key * kTsdfBlockSide + Eigen::Vector3i(x, y, z);
           for (int axis = 0; axis < 3; ++axis) {
             Eigen::Vector3i step = Eigen::Vector3i::Zero();

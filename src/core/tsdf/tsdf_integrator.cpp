@@ -109,6 +109,10 @@ struct DepthFrame {
   /// |cos(incidence)| per pixel (incidenceCosines; -1 unknown), when the rim distance rule or
   /// the grazing reach needs it; empty otherwise.
   std::vector<float> cosine;
+  /// Per pixel, how deep behind its surface (m along the ray) an update still confirms a voxel
+  /// (TsdfConfig::confirm_depth_voxels over the incidence's cosine; +Inf where the incidence is
+  /// unknown); empty when off or without incidences (every update confirms).
+  std::vector<float> confirm_depth;
   std::vector<float> column_x;     ///< scratch of incidenceCosines
   std::vector<std::uint8_t> edge;  ///< scratch: the discontinuities' seeds
   std::vector<std::uint8_t> rows;  ///< scratch: the seeds dilated along rows
@@ -120,6 +124,23 @@ struct DepthFrame {
   std::vector<std::uint8_t> smooth;
   float min_depth = std::numeric_limits<float>::infinity();
 };
+
+/// f->confirm_depth from the incidences (f->cosine): along the normal confirm_depth_voxels
+/// voxels behind the surface is that over the cosine along the ray. Unknown incidences confirm
+/// at any depth (the frame cannot tell how deep along the normal its ray is).
+void confirmDepths(const TsdfConfig& c, float voxel, DepthFrame* f) {
+  if (!(c.confirm_depth_voxels > 0.0) || f->cosine.empty()) {
+    f->confirm_depth.clear();
+    return;
+  }
+  const float along_normal = static_cast<float>(c.confirm_depth_voxels) * voxel;
+  const float inf = std::numeric_limits<float>::infinity();
+  f->confirm_depth.resize(f->cosine.size());
+  for (std::size_t i = 0; i < f->cosine.size(); ++i) {
+    const float cosine = f->cosine[i];
+    f->confirm_depth[i] = cosine > 0.0f ? along_normal / cosine : inf;
+  }
+}
 
 void computeRangePerDepth(const PinholeCamera& camera, DepthFrame* f) {
   const std::size_t n = static_cast<std::size_t>(camera.width) * camera.height;
@@ -426,6 +447,7 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   } else {
     f.allowed.clear();
   }
+  confirmDepths(c, rs.voxel, &f);
 }
 
 /// Blocks the truncation band of the valid pixels passes through, from mu in front of the
@@ -600,6 +622,9 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
   alignas(32) int flags[kTsdfBlockSide] = {};  // 1: interpolate
   alignas(32) float allowed[kTsdfBlockSide] = {};
   const float* allowed_px = frame.allowed.data();
+  alignas(32) float confirm_depth[kTsdfBlockSide] = {};
+  const bool has_confirm_depth = !frame.confirm_depth.empty();
+  const float* confirm_depth_px = frame.confirm_depth.data();
   // The blocks are found (or allocated) first, so each block's integration can prefetch the
   // next block's voxels: blocks lie scattered in memory, where the hardware prefetcher does not
   // follow.
@@ -664,6 +689,8 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
           // The pixel's allowance behind its surface, for every voxel (pass 3 reads it for all
           // eight): deeper voxels skip the loads below.
           allowed[x] = has_allowed ? allowed_px[px] : muf;
+          confirm_depth[x] =
+              has_confirm_depth ? confirm_depth_px[px] : std::numeric_limits<float>::infinity();
           const float along_axis = nearest[x] - zc[x];
           // Behind the band, or NaN (|sdf| >= |along_axis|: the ray is at least as long).
           if (!(along_axis >= -allowed[x] - max_step)) continue;
@@ -712,7 +739,10 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
           const float dn = std::max(-1.0f, std::min(1.0f, sdf * inv_mu));
           const float obs_w = weight(no_return ? z_axis : nearest[x], sdf);
           TsdfVoxel& voxel = row_voxels[x];
-          const TsdfVoxel fused = map->fused(voxel, dn, obs_w);
+          // Deeper than confirm_depth_voxels along the normal: the update fuses but does not
+          // confirm the voxel (a slab's far side, which no frame may ever see).
+          const bool confirms = !(in_band & (sdf < -confirm_depth[x]));
+          const TsdfVoxel fused = map->fused(voxel, dn, obs_w, confirms);
           voxel.distance = update ? fused.distance : voxel.distance;
           voxel.weight = update ? fused.weight : voxel.weight;
           updated += update;

@@ -19,6 +19,14 @@ std::string TsdfConfig::inertSettings() const {
              edge_guard_rim_scale != defaults.edge_guard_rim_scale) {
     why << "edge_guard_rim_scale " << edge_guard_rim_scale
         << " has no effect with edge_guard_rule fixed_radius; it applies with rim_distance";
+  } else if (confirm_depth_voxels != defaults.confirm_depth_voxels && confirm_depth_voxels > 0.0 &&
+             !(edge_guard_rule == EdgeGuardRule::kRimDistance && edge_guard_rad > 0.0) &&
+             !(grazing_reach_voxels > 0.0)) {
+    // Only these two estimate the pixels' incidences, which say how deep along the normal a
+    // voxel lies.
+    why << "confirm_depth_voxels " << confirm_depth_voxels
+        << " has no effect without incidence estimates (edge_guard_rule rim_distance with "
+           "edge_guard_rad > 0, or grazing_reach_voxels > 0)";
   }
   return why.str();
 }
@@ -59,6 +67,8 @@ std::string TsdfConfig::validate() const {
     why << "behind_surface_dropoff_start_voxels must be finite and >= 0 (>= truncation_voxels = "
            "no ramp), got "
         << behind_surface_dropoff_start_voxels;
+  } else if (!(confirm_depth_voxels >= 0.0 && confirm_depth_voxels <= 64.0)) {
+    why << "confirm_depth_voxels must be in [0, 64] (0 = off), got " << confirm_depth_voxels;
   } else if (max_blocks < 1) {
     why << "max_blocks must be >= 1";
   } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {

@@ -163,7 +163,7 @@ std::vector<SliceCell> sliceTsdf(const TsdfMap& map, const GridGeometry& grid,
       for (int y = 0; y < kTsdfBlockSide; ++y) {
         for (int x = 0; x < kTsdfBlockSide; ++x) {
           const TsdfVoxel& v = block->voxels[TsdfBlock::linear(x, y, z)];
-          if (!(v.weight > min_weight)) continue;
+          if (!(v.observedWeight() > min_weight)) continue;
           // Voxel centres often lie exactly on cell edges (same resolution, origin on the
           // lattice); a nudge of 1e-4 voxel breaks the tie the same way for every voxel, so no
           // cell is skipped through rounding.

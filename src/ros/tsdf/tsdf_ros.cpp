@@ -139,6 +139,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.max_weight = cfg.max_weight;
   next.behind_surface_dropoff = cfg.behind_surface_dropoff;
   next.behind_surface_dropoff_start_voxels = cfg.behind_surface_dropoff_start_voxels;
+  next.confirm_depth_voxels = cfg.confirm_depth_voxels;
   next.edge_guard_rad = cfg.edge_guard_rad;
   next.edge_guard_near_side_only = cfg.edge_guard_near_side_only;
   next.edge_guard_grazing_voxels = cfg.edge_guard_grazing_voxels;

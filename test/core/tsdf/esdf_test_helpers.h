@@ -110,7 +110,8 @@ struct OracleComparison {
   std::size_t occupied = 0;  ///< known voxels with a negative oracle value
 };
 
-/// Brute force: for every voxel of the map's blocks, the state from the TSDF (unknown: weight
+/// Brute force: for every voxel of the map's blocks, the state from the TSDF (unknown: observed
+/// weight
 /// <= min_weight; occupied: D < 0; else free), and for every known voxel the smallest squared
 /// lattice distance to a voxel of the other known state, by scanning every voxel of the cube
 /// of the ESDF's radius around it (seeds farther away give the clamp anyway).
@@ -136,7 +137,7 @@ inline OracleComparison compareWithOracle(const TsdfMap& map, const Esdf& esdf,
     for (int y = lo.y(); y <= hi.y(); ++y) {
       for (int x = lo.x(); x <= hi.x(); ++x) {
         const TsdfVoxel* v = map.voxel({x, y, z});
-        if (v != nullptr && v->weight > map.config().min_weight) {
+        if (v != nullptr && v->observedWeight() > map.config().min_weight) {
           state[at({x, y, z})] = v->distance < 0.0f ? 2 : 1;
         }
       }

@@ -58,7 +58,7 @@ BandOracle compareBandWithOracle(const TsdfMap& map, const EsdfBandConfig& c,
       int& st = state[g.index(cx, cy)];
       for (int k = first; k <= last; ++k) {
         const TsdfVoxel* v = map.voxel({i0 + cx, j0 + cy, k});
-        if (v == nullptr || !(v->weight > map.config().min_weight)) continue;
+        if (v == nullptr || !(v->observedWeight() > map.config().min_weight)) continue;
         st = std::max(st, v->distance < 0.0f ? 2 : 1);
       }
     }

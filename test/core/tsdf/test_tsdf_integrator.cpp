@@ -211,7 +211,7 @@ TEST(Tsdf, EveryVoxelHoldsTheProjectiveUpdateOfItsPixel) {
     c.behind_surface_dropoff = (variant & 2) != 0;
     TsdfMap map(c);
     const TsdfIntegrationStats stats = integrateDepth(&map, depth.data(), camera, T_map_camera);
-    std::size_t checked = 0, updated = 0;
+    std::size_t checked = 0, updated = 0, unconfirmed = 0;
     for (const auto& kv : map.blocks()) {
       for (int i = 0; i < kTsdfBlockVoxels; ++i) {
         const Eigen::Vector3i voxel =
@@ -256,14 +256,21 @@ TEST(Tsdf, EveryVoxelHoldsTheProjectiveUpdateOfItsPixel) {
           expected_w = c.behind_surface_dropoff && sdf < -s ? (mu + sdf) / (mu - s) : 1.0;
         }
         const TsdfVoxel& got = kv.second->voxels[i];
-        ASSERT_NEAR(got.weight, expected_w, 1e-4) << "voxel " << voxel.transpose();
+        ASSERT_NEAR(got.observedWeight(), expected_w, 1e-4) << "voxel " << voxel.transpose();
         if (expected_w > 0.0) {
           ASSERT_NEAR(got.distance, expected_d, 1e-4) << "voxel " << voxel.transpose();
           ++updated;
         }
+        // Unconfirmed only deeper than confirm_depth_voxels along the normal, so at least that
+        // deep along the ray.
+        if (got.weight < 0.0f) {
+          ASSERT_LT(sdf, -c.confirm_depth_voxels * s * (1.0 - 1e-4)) << voxel.transpose();
+          ++unconfirmed;
+        }
         ++checked;
       }
     }
+    EXPECT_GT(unconfirmed, 100u);
     EXPECT_GT(updated, 15000u);
     EXPECT_GT(checked, updated + 15000u);  // also many voxels the frame leaves untouched
     EXPECT_GE(stats.voxels_updated, updated);

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -47,6 +48,14 @@ struct TsdfConfig {
   /// default before issue 22); later starts land between that and no ramp (docs/tsdf.md). A value
   /// >= truncation_voxels means no ramp (like behind_surface_dropoff false).
   double behind_surface_dropoff_start_voxels = 1.0;
+  /// Depth images: a voxel that frames have only seen deeper than this many voxels behind their
+  /// surface (along the surface's normal, where the pixel's incidence is known) is unconfirmed
+  /// (TsdfVoxel::weight < 0): its values fuse as usual, and the ESDF, the slice and queries read
+  /// it, but the mesh leaves it out until some frame sees it nearer a surface or in front of
+  /// one. Behind a slab thinner than mu seen only from above (a table top), its deep "inside"
+  /// values would otherwise mesh a skirt below the slab's underside where rays beside the slab
+  /// see free space (issue 22; docs/tsdf.md). 0 = off (every update confirms).
+  double confirm_depth_voxels = 2.5;
   /// Depth images: how far behind the surface a pixel next to a depth edge (an object's rim)
   /// writes "inside" values. Rays grazing a rim would otherwise write them into the free space
   /// beyond the object's edges (the projective TSDF's ghost surfaces). A depth edge: neighbouring
@@ -133,7 +142,12 @@ struct TsdfConfig {
 
 struct TsdfVoxel {
   float distance = 0.0f;  ///< normalised signed distance D in [-1, 1]
+  /// Fused weight; negative while the voxel is unconfirmed (TsdfConfig::confirm_depth_voxels),
+  /// its magnitude the weight. The sign keeps the voxel 8 bytes, and readers that test
+  /// weight > min_weight (the mesh) leave unconfirmed voxels out without a further check.
   float weight = 0.0f;
+  /// The fused weight whether confirmed or not: what the ESDF, the slice and queries read.
+  float observedWeight() const { return std::abs(weight); }
 };
 
 constexpr int kTsdfBlockSide = 8;
@@ -205,13 +219,17 @@ class TsdfMap {
 
   /// Voxel v after fusing one observation (normalised distance d, weight w). A plain function
   /// of values, so the integrator's loop over a row of voxels vectorises.
-  TsdfVoxel fused(const TsdfVoxel& v, float d, float w) const {
-    const float total = v.weight + w;
+  /// `confirms`: false for an observation deeper than confirm_depth_voxels behind its surface;
+  /// the voxel stays (or becomes) unconfirmed unless it was confirmed before.
+  TsdfVoxel fused(const TsdfVoxel& v, float d, float w, bool confirms = true) const {
+    const float prior = v.observedWeight();
+    const float total = prior + w;
     // A zero-weight observation of an unobserved voxel (exactly mu behind the surface with the
-    // drop-off) would be 0 / 0: the voxel keeps its value and stays unobserved. A select, so the
-    // integration loop still vectorises.
-    const float average = (v.weight * v.distance + w * d) / total;
-    return {total > 0.0f ? average : v.distance, std::min(total, weight_cap_)};
+    // drop-off) would be 0 / 0: the voxel keeps its value and stays unobserved. Selects only, so
+    // the integration loop still vectorises.
+    const float average = (prior * v.distance + w * d) / total;
+    const float weight = std::min(total, weight_cap_);
+    return {total > 0.0f ? average : v.distance, confirms | (v.weight > 0.0f) ? weight : -weight};
   }
   /// Fuses one observation (normalised distance d, weight w) into a voxel.
   void fuse(TsdfVoxel* v, float d, float w) const { *v = fused(*v, d, w); }
