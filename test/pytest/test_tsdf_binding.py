@@ -136,6 +136,15 @@ def room_frames(image: str) -> tuple:
     return cam, scene, poses, depths, observed_samples(scene, cam, poses, depths)
 
 
+def fused_mesh(config: dp.TsdfConfig, cam: DepthCamera, poses: list, depths: list) -> tuple:
+    """A Tsdf of `config` fused from the frames, and its mesh."""
+    tsdf = dp.Tsdf(config)
+    for pose, depth in zip(poses, depths, strict=True):
+        tsdf.integrate_depth(depth, camera(cam), pose)
+    tsdf.update_mesh()
+    return tsdf, tsdf.mesh()
+
+
 def room_tsdf_5cm() -> dp.Tsdf:
     """The room fused from its 320x240 frames at 5 cm voxels."""
     cam, _, poses, depths, _ = room_frames("qvga")
@@ -213,11 +222,7 @@ def test_edge_guard_removes_ghosts() -> None:
     for guard in (0.0, 0.0075):
         config = dp.TsdfConfig()
         config.edge_guard_rad = guard
-        tsdf = dp.Tsdf(config)
-        for pose, depth in zip(poses, depths, strict=True):
-            tsdf.integrate_depth(depth, camera(cam), pose)
-        tsdf.update_mesh()
-        mesh = tsdf.mesh()
+        _, mesh = fused_mesh(config, cam, poses, depths)
         ghosts[guard] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
     assert ghosts[0.0075].ghost_fraction * 3 < ghosts[0.0].ghost_fraction
     assert ghosts[0.0075].completeness > ghosts[0.0].completeness - 0.002
@@ -241,11 +246,7 @@ def test_rim_distance_rule_and_grazing_reach_fill_the_corridor_without_ghosts() 
     before.grazing_reach_voxels = 0.0
     scores = {}
     for name, config in (("rim", defaults), ("before", before)):
-        tsdf = dp.Tsdf(config)
-        for pose, depth in zip(poses, depths, strict=True):
-            tsdf.integrate_depth(depth, camera(cam), pose)
-        tsdf.update_mesh()
-        mesh = tsdf.mesh()
+        _, mesh = fused_mesh(config, cam, poses, depths)
         scores[name] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
     assert scores["rim"].completeness > scores["before"].completeness + 0.004
     assert scores["rim"].ghost_fraction <= scores["before"].ghost_fraction
@@ -278,11 +279,7 @@ def test_rays_near_a_balls_silhouette_reach_its_depth(scene_name: str) -> None:
         on_ball = np.abs(np.linalg.norm(observed - centre, axis=1) - ball.radius) < 1e-3
         lower |= on_ball & (observed[:, 2] < centre[2] - 0.3 * ball.radius)
     assert lower.sum() > 1000
-    tsdf = dp.Tsdf(dp.TsdfConfig())
-    for pose, depth in zip(poses, depths, strict=True):
-        tsdf.integrate_depth(depth, camera(cam), pose)
-    tsdf.update_mesh()
-    mesh = tsdf.mesh()
+    _, mesh = fused_mesh(dp.TsdfConfig(), cam, poses, depths)
     covered = near_mesh(observed[lower], mesh["vertices"], mesh["triangles"], 0.02)
     assert covered.mean() > 0.965
     score = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
@@ -306,11 +303,7 @@ def test_unconfirmed_voxels_keep_the_table_tops_underside_clean() -> None:
     for confirm in (0.0, 2.5):
         config = dp.TsdfConfig()
         config.confirm_depth_voxels = confirm
-        tsdf = dp.Tsdf(config)
-        for pose, depth in zip(poses, depths, strict=True):
-            tsdf.integrate_depth(depth, camera(cam), pose)
-        tsdf.update_mesh()
-        mesh = tsdf.mesh()
+        tsdf, mesh = fused_mesh(config, cam, poses, depths)
         scores[confirm] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
         # 2.5 cm under the top's underside (z 0.72 m): "inside", seen only from above the top.
         grid = np.stack(np.meshgrid(np.arange(-1.15, -0.45, 0.1), np.arange(0.45, 0.95, 0.1)), -1)
