@@ -113,20 +113,17 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
       }
       const int q = hull[k];
       const std::int32_t nearest = seed_row[q] * w + q;
+      const auto fill = [&](auto gq) {  // gq's type: the arithmetic's width
+        for (int x = u; x < end; ++x) {
+          const decltype(gq) du = x - q;
+          squared_out[x] = static_cast<float>(du * du + gq);
+          seed_out[x] = nearest;
+        }
+      };
       if (fits_32) {
-        const std::int32_t gq = g[q];
-        for (int x = u; x < end; ++x) {
-          const std::int32_t du = x - q;
-          squared_out[x] = static_cast<float>(du * du + gq);
-          seed_out[x] = nearest;
-        }
+        fill(static_cast<std::int32_t>(g[q]));
       } else {
-        const std::int64_t gq = g[q];
-        for (int x = u; x < end; ++x) {
-          const std::int64_t du = x - q;
-          squared_out[x] = static_cast<float>(du * du + gq);
-          seed_out[x] = nearest;
-        }
+        fill(static_cast<std::int64_t>(g[q]));
       }
       std::size_t plane = 0;
       for (const float* values : planes) {
