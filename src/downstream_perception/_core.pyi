@@ -445,6 +445,13 @@ class TsdfConfig:
         self, arg0: typing.SupportsFloat | typing.SupportsIndex
     ) -> None: ...
     @property
+    def incidence_window_radius_px(self) -> int:
+        """
+        Depth images: incidences (rim rule, grazing reach, confirm depth) from the plane of the (2 r + 1)^2 pixels around each pixel where they all continue one surface (then radius r / 2, then 1), robust to depth noise; 0 = the nearest neighbours only.
+        """
+    @incidence_window_radius_px.setter
+    def incidence_window_radius_px(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None: ...
+    @property
     def confirm_depth_voxels(self) -> float:
         """
         Depth images: a voxel only ever seen deeper than this many voxels behind a surface (along its normal) is unconfirmed: it fuses and the ESDF, slice and sample() read it, but the mesh leaves it out until a frame sees it nearer a surface or in front of one (a thin slab's unseen underside). 0 = off.

@@ -236,6 +236,11 @@ void bindTsdf(py::module& m) {
                      "With behind_surface_dropoff, the weight stays 1 up to this many voxels "
                      "behind the surface, then falls linearly to 0 at -mu (1 = voxblox's ramp; "
                      ">= truncation_voxels = no ramp).")
+      .def_readwrite("incidence_window_radius_px", &TsdfConfig::incidence_window_radius_px,
+                     "Depth images: incidences (rim rule, grazing reach, confirm depth) from the "
+                     "plane of the (2 r + 1)^2 pixels around each pixel where they all continue "
+                     "one surface (then radius r / 2, then 1), robust to depth noise; 0 = the "
+                     "nearest neighbours only.")
       .def_readwrite("confirm_depth_voxels", &TsdfConfig::confirm_depth_voxels,
                      "Depth images: a voxel only ever seen deeper than this many voxels behind a "
                      "surface (along its normal) is unconfirmed: it fuses and the ESDF, slice "

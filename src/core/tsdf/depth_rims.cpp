@@ -1,7 +1,5 @@
 #include "downstream_perception/core/tsdf/depth_rims.h"
 
-#include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -131,116 +129,6 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
         std::fill(value_out + u, value_out + end, values[nearest]);
       }
       u = end;
-    }
-  }
-}
-
-float incidenceCosine(const PinholeCamera& camera, const float* depth, const float* inverse, int u,
-                      int v, float jump) {
-  const int w = camera.width, h = camera.height;
-  const float inv_fx = static_cast<float>(1.0 / camera.fx);
-  const float inv_fy = static_cast<float>(1.0 / camera.fy);
-  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
-  const auto point = [&](int uu, int vv, float d) {
-    return Eigen::Vector3f((static_cast<float>(uu) - cx) * inv_fx * d,
-                           (static_cast<float>(vv) - cy) * inv_fy * d, d);
-  };
-  const std::size_t i = static_cast<std::size_t>(v) * w + u;
-  const float d = depth[i];
-  const Eigen::Vector3f p = point(u, v, d);
-  // The tangent towards the neighbour (either side) nearest in depth, within `jump`. Far away
-  // at grazing incidence a surface steps by more than that per pixel: no estimate there. (Taking
-  // a neighbour that continues a plane instead was tried: the grazing reach then ran past thin
-  // boards' far edges into the gap behind them, a sampling the rims cannot see: ghosts 0.006 ->
-  // 0.037 % median over the accuracy scenes.)
-  const auto tangent = [&](int du, int dv, Eigen::Vector3f* t) {
-    float best = jump;
-    bool found = false;
-    for (const int sign : {-1, 1}) {
-      const int uu = u + sign * du, vv = v + sign * dv;
-      if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
-      const std::size_t j = static_cast<std::size_t>(vv) * w + uu;
-      const float diff = std::abs(depth[j] - d);
-      if (inverse[j] == 0.0f || !(diff <= best)) continue;
-      best = diff;
-      *t = point(uu, vv, depth[j]) - p;
-      found = true;
-    }
-    return found;
-  };
-  Eigen::Vector3f tu, tv;
-  if (!tangent(1, 0, &tu) || !tangent(0, 1, &tv)) return -1.0f;
-  const Eigen::Vector3f normal = tu.cross(tv);
-  const float norms = normal.norm() * p.norm();
-  if (!(norms > 0.0f)) return -1.0f;
-  return std::min(1.0f, std::abs(normal.dot(p)) / norms);
-}
-
-void incidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
-                      float jump, std::vector<float>* column_x, float* cosine) {
-  const int w = camera.width, h = camera.height;
-  column_x->resize(static_cast<std::size_t>(w));
-  float* xs = column_x->data();
-  for (int u = 0; u < w; ++u) xs[u] = static_cast<float>((u - camera.cx) / camera.fx);
-  incidenceCosinesInterior(camera, depth, inverse, jump, xs, cosine);
-  // The image's border pixels (one neighbour missing on a side) one at a time.
-  for (int u = 0; u < w; ++u) {
-    cosine[u] = incidenceCosine(camera, depth, inverse, u, 0, jump);
-    const std::size_t last = static_cast<std::size_t>(h - 1) * w + u;
-    cosine[last] = incidenceCosine(camera, depth, inverse, u, h - 1, jump);
-  }
-  for (int v = 1; v + 1 < h; ++v) {
-    const std::size_t row = static_cast<std::size_t>(v) * w;
-    cosine[row] = incidenceCosine(camera, depth, inverse, 0, v, jump);
-    cosine[row + w - 1] = incidenceCosine(camera, depth, inverse, w - 1, v, jump);
-  }
-}
-
-DP_AVX2_CLONES
-void incidenceCosinesInterior(const PinholeCamera& camera, const float* depth, const float* inverse,
-                              float jump, const float* xs, float* cosine) {
-  const int w = camera.width, h = camera.height;
-  // Branch-free (selects only) so the row loop vectorises; the same choices and arithmetic as
-  // incidenceCosine, which the gtests compare it with.
-  for (int v = 1; v + 1 < h; ++v) {
-    const float y = static_cast<float>((v - camera.cy) / camera.fy);
-    const float y_up = static_cast<float>((v - 1 - camera.cy) / camera.fy);
-    const float y_down = static_cast<float>((v + 1 - camera.cy) / camera.fy);
-    const std::size_t row = static_cast<std::size_t>(v) * w;
-    const float* d = depth + row;
-    const float* iv = inverse + row;
-    float* out = cosine + row;
-    for (int u = 1; u + 1 < w; ++u) {
-      const float dc = d[u];
-      const float x = xs[u];
-      // Along the row: the left neighbour if within jump, the right one if within jump and at
-      // least as near in depth (incidenceCosine visits left, then right, keeping ties right).
-      const float dl = d[u - 1], dr = d[u + 1];
-      const float el = std::abs(dl - dc), er = std::abs(dr - dc);
-      const bool okl = (iv[u - 1] != 0.0f) & (el <= jump);
-      const bool okr = (iv[u + 1] != 0.0f) & (er <= jump);
-      const bool right = okr & (!okl | (er <= el));
-      const float dh = right ? dr : dl;
-      const float xh = right ? xs[u + 1] : xs[u - 1];
-      const float tux = xh * dh - x * dc, tuy = y * dh - y * dc, tuz = dh - dc;
-      // Along the column: up, then down.
-      const float du = d[u - w], dd = d[u + w];
-      const float eu = std::abs(du - dc), ed = std::abs(dd - dc);
-      const bool oku = (iv[u - w] != 0.0f) & (eu <= jump);
-      const bool okd = (iv[u + w] != 0.0f) & (ed <= jump);
-      const bool down = okd & (!oku | (ed <= eu));
-      const float dvv = down ? dd : du;
-      const float yv = down ? y_down : y_up;
-      const float tvx = x * dvv - x * dc, tvy = yv * dvv - y * dc, tvz = dvv - dc;
-      const float nx = tuy * tvz - tuz * tvy;
-      const float ny = tuz * tvx - tux * tvz;
-      const float nz = tux * tvy - tuy * tvx;
-      const float px = x * dc, py = y * dc, pz = dc;
-      const float norms =
-          std::sqrt(nx * nx + ny * ny + nz * nz) * std::sqrt(px * px + py * py + pz * pz);
-      const float c = std::min(1.0f, std::abs(nx * px + ny * py + nz * pz) / norms);
-      const bool ok = (iv[u] != 0.0f) & (okl | okr) & (oku | okd) & (norms > 0.0f);
-      out[u] = ok ? c : -1.0f;
     }
   }
 }

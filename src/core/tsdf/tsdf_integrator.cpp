@@ -113,11 +113,12 @@ struct DepthFrame {
   /// (TsdfConfig::confirm_depth_voxels over the incidence's cosine; +Inf where the incidence is
   /// unknown); empty when off or without incidences (every update confirms).
   std::vector<float> confirm_depth;
-  std::vector<float> column_x;     ///< scratch of incidenceCosines
-  std::vector<std::uint8_t> edge;  ///< scratch: the discontinuities' seeds
-  std::vector<std::uint8_t> rows;  ///< scratch: the seeds dilated along rows
-  std::vector<float> seed_depth;   ///< scratch: the seeds' depths, then their window minimum
-  std::vector<float> rows_depth;   ///< scratch: the seeds' depths' minimum along rows
+  std::vector<float> column_x;              ///< scratch of incidenceCosines
+  IncidenceWindowScratch incidence_window;  ///< scratch of windowIncidenceCosines
+  std::vector<std::uint8_t> edge;           ///< scratch: the discontinuities' seeds
+  std::vector<std::uint8_t> rows;           ///< scratch: the seeds dilated along rows
+  std::vector<float> seed_depth;  ///< scratch: the seeds' depths, then their window minimum
+  std::vector<float> rows_depth;  ///< scratch: the seeds' depths' minimum along rows
   /// 1 where the 2 x 2 pixels from this one (right, down) are all valid depths within a voxel
   /// of each other: inverse depth may be interpolated between them. Checked once per pixel here
   /// instead of once per voxel in the integration loop (empty without interpolate_depth).
@@ -421,6 +422,12 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   if (rim_rule || rs.reach > 0.0f) {
     f.cosine.resize(n);
     incidenceCosines(camera, f.depth.data(), f.inverse.data(), mu, &f.column_x, f.cosine.data());
+    // Window pairs continue a surface within two voxels (at most mu): a face seen at grazing
+    // incidence steps by more per pixel, and its windows would reach across the crease into
+    // the face beside it.
+    const float window_jump = std::min(mu, static_cast<float>(2.0 * c.voxel_size_m));
+    windowIncidenceCosines(camera, f.depth.data(), f.inverse.data(), window_jump,
+                           c.incidence_window_radius_px, &f.incidence_window, f.cosine.data());
   } else {
     f.cosine.clear();
   }

@@ -10,6 +10,14 @@ namespace downstream_perception {
 std::string TsdfConfig::inertSettings() const {
   const TsdfConfig defaults;
   std::ostringstream why;
+  // Only these two estimate the pixels' incidences, which say how deep along the normal a voxel
+  // lies (confirm_depth_voxels) and which the incidence window refines.
+  const bool estimates_incidences =
+      (edge_guard_rule == EdgeGuardRule::kRimDistance && edge_guard_rad > 0.0) ||
+      grazing_reach_voxels > 0.0;
+  const char* no_incidences =
+      " has no effect without incidence estimates (edge_guard_rule rim_distance with "
+      "edge_guard_rad > 0, or grazing_reach_voxels > 0)";
   if (edge_guard_rule == EdgeGuardRule::kRimDistance &&
       edge_guard_grazing_voxels != defaults.edge_guard_grazing_voxels) {
     why << "edge_guard_grazing_voxels " << edge_guard_grazing_voxels
@@ -20,13 +28,11 @@ std::string TsdfConfig::inertSettings() const {
     why << "edge_guard_rim_scale " << edge_guard_rim_scale
         << " has no effect with edge_guard_rule fixed_radius; it applies with rim_distance";
   } else if (confirm_depth_voxels != defaults.confirm_depth_voxels && confirm_depth_voxels > 0.0 &&
-             !(edge_guard_rule == EdgeGuardRule::kRimDistance && edge_guard_rad > 0.0) &&
-             !(grazing_reach_voxels > 0.0)) {
-    // Only these two estimate the pixels' incidences, which say how deep along the normal a
-    // voxel lies.
-    why << "confirm_depth_voxels " << confirm_depth_voxels
-        << " has no effect without incidence estimates (edge_guard_rule rim_distance with "
-           "edge_guard_rad > 0, or grazing_reach_voxels > 0)";
+             !estimates_incidences) {
+    why << "confirm_depth_voxels " << confirm_depth_voxels << no_incidences;
+  } else if (incidence_window_radius_px != defaults.incidence_window_radius_px &&
+             incidence_window_radius_px > 0 && !estimates_incidences) {
+    why << "incidence_window_radius_px " << incidence_window_radius_px << no_incidences;
   }
   return why.str();
 }
@@ -69,6 +75,9 @@ std::string TsdfConfig::validate() const {
         << behind_surface_dropoff_start_voxels;
   } else if (!(confirm_depth_voxels >= 0.0 && confirm_depth_voxels <= 64.0)) {
     why << "confirm_depth_voxels must be in [0, 64] (0 = off), got " << confirm_depth_voxels;
+  } else if (!(incidence_window_radius_px >= 0 && incidence_window_radius_px <= 64)) {
+    why << "incidence_window_radius_px must be in [0, 64] (0 = off), got "
+        << incidence_window_radius_px;
   } else if (max_blocks < 1) {
     why << "max_blocks must be >= 1";
   } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {

@@ -36,6 +36,7 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   readParam(pnh, "behind_surface_dropoff_start_voxels", &c.behind_surface_dropoff_start_voxels,
             errors);
   readParam(pnh, "confirm_depth_voxels", &c.confirm_depth_voxels, errors);
+  readParam(pnh, "incidence_window_radius_px", &c.incidence_window_radius_px, errors);
   readParam(pnh, "interpolate_depth", &c.interpolate_depth, errors);
   readParam(pnh, "carve_free_space", &c.carve_free_space, errors);
   readParam(pnh, "no_return_carve_min_valid_fraction", &c.no_return_carve_min_valid_fraction,

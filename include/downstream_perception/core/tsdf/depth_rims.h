@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "downstream_perception/core/tsdf/depth_incidence.h"
+
 namespace downstream_perception {
 
 struct PinholeCamera;
@@ -41,14 +43,6 @@ void seedDistances(int w, int h, const std::uint8_t* seeds, SeedDistances* out,
                    float max_distance_px = std::numeric_limits<float>::infinity(),
                    std::initializer_list<const float*> planes = {});
 
-/// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
-/// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when
-/// either direction has no such neighbour (a far grazing surface stepping by more than jump per
-/// pixel) or the surface is degenerate. depth: m (NaN where not
-/// valid); inverse: 1 / depth, 0 where not a valid depth.
-float incidenceCosine(const PinholeCamera& camera, const float* depth, const float* inverse, int u,
-                      int v, float jump);
-
 /// Settings of rimAllowances, all lengths in metres.
 struct RimAllowanceSettings {
   float voxel = 0.0f;       ///< voxel size
@@ -67,15 +61,6 @@ struct RimAllowanceSettings {
   /// px): how much a plane's incidence can change from pixel to pixel.
   float radians_per_px = 0.0f;
 };
-
-/// incidenceCosine for every pixel of the image, into `cosine` (w * h): the interior rows
-/// branch-free (vectorised), the border pixels one at a time. column_x: scratch, reused.
-void incidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
-                      float jump, std::vector<float>* column_x, float* cosine);
-/// The interior pixels of incidenceCosines (not the image's first and last rows and columns);
-/// xs[u] = (u - cx) / fx.
-void incidenceCosinesInterior(const PinholeCamera& camera, const float* depth, const float* inverse,
-                              float jump, const float* xs, float* cosine);
 
 /// A rim whose incidence sine exceeds a pixel's by more than a plane allows (the angle between
 /// their rays) plus this is taken as the silhouette of a surface turning towards the line of

@@ -1,0 +1,56 @@
+// The angle at which each pixel's ray meets the surface it sees, estimated from a depth image:
+// the rim distance rule, the grazing reach and unconfirmed voxels of the TSDF integrator read it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace downstream_perception {
+
+struct PinholeCamera;
+
+/// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
+/// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when
+/// either direction has no such neighbour (a far grazing surface stepping by more than jump per
+/// pixel) or the surface is degenerate. depth: m (NaN where not
+/// valid); inverse: 1 / depth, 0 where not a valid depth.
+float incidenceCosine(const PinholeCamera& camera, const float* depth, const float* inverse, int u,
+                      int v, float jump);
+
+/// incidenceCosine for every pixel of the image, into `cosine` (w * h): the interior rows
+/// branch-free (vectorised), the border pixels one at a time. column_x: scratch, reused.
+void incidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
+                      float jump, std::vector<float>* column_x, float* cosine);
+/// The interior pixels of incidenceCosines (not the image's first and last rows and columns);
+/// xs[u] = (u - cx) / fx.
+void incidenceCosinesInterior(const PinholeCamera& camera, const float* depth, const float* inverse,
+                              float jump, const float* xs, float* cosine);
+
+/// Scratch of windowIncidenceCosines, reused from frame to frame.
+struct IncidenceWindowScratch {
+  /// Per pixel, 1 where it breaks a surface: not valid, or more than `jump` in depth from the
+  /// next pixel along its row or its column.
+  std::vector<std::uint8_t> bad;
+  std::vector<float> across;  ///< per radius, inverse depth summed across the window per pixel
+  /// Per radius, a row's sums down the window's rows (inverse depth, bad pixels).
+  std::vector<float> down;
+  std::vector<std::uint8_t> down_bad;
+  std::vector<std::uint8_t> window_bad;  ///< a row's: any bad pixel in the window
+  std::vector<float> slope_x, slope_y;   ///< a row's inverse-depth slopes (largest clean window)
+  std::vector<std::int32_t> found;       ///< a row's: some window was clean
+};
+
+/// A noise-robust incidence for pixels inside a surface: where every neighbour pair of the
+/// (2 radius + 1)^2 pixels around a pixel, and from them to the next pixel right and down,
+/// continues one surface (both valid, depths within `jump`), `cosine` is overwritten with the
+/// incidence of the window's mean inverse-depth slopes; failing that, the same with a window of
+/// half the radius, then of radius 1; pixels with none keep their value (incidenceCosines'). On a
+/// plane inverse depth is affine in the image, so the slopes are the plane's exactly, while a
+/// pixel's own neighbours see depth noise of a few mm over one pixel. Windows are centred (a
+/// shifted one would, near a curved surface's silhouette, report the less grazing incidence of the
+/// surface inside it). radius 0: nothing changes. O(pixels) whatever the radius (summed-area
+/// tables).
+void windowIncidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
+                            float jump, int radius, IncidenceWindowScratch* scratch, float* cosine);
+
+}  // namespace downstream_perception
