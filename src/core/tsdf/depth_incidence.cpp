@@ -162,6 +162,12 @@ int windowRadii(int radius, int radii[3]) {
   return count;
 }
 
+}  // namespace
+
+// External linkage on purpose (DP_AVX2_CLONES): a function local to this file would have its
+// clone chosen while the library loads, before a sanitizer's runtime is up.
+namespace detail {
+
 /// windowIncidenceCosines past the bad pixels. Every window sum is a plain sum (nothing drifts)
 /// and the radii nest: a larger window's sum is the smaller one's plus its outer rows (or
 /// columns). Each loop runs along a row, so it vectorises.
@@ -257,7 +263,7 @@ void windowCosines(const PinholeCamera& camera, const float* inverse, const int*
   }
 }
 
-}  // namespace
+}  // namespace detail
 
 void windowIncidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
                             float jump, int radius, IncidenceWindowScratch* scratch,
@@ -300,7 +306,7 @@ void windowIncidenceCosines(const PinholeCamera& camera, const float* depth, con
       out[w - 1] = rho[w - 1] == 0.0f;
     }
   }
-  windowCosines(camera, inverse, radii, count, scratch, cosine);
+  detail::windowCosines(camera, inverse, radii, count, scratch, cosine);
 }
 
 }  // namespace downstream_perception
