@@ -49,9 +49,11 @@ def ours(
     poses: Sequence[np.ndarray],
     cam: Any,
     rule_before_defect_4: bool = False,
+    incidence_window: bool = True,
 ) -> Timing:
     """Default settings; rule_before_defect_4: the fixed-radius edge guard without the grazing
-    reach (issue 22's rule before defect 4, cheaper per pixel)."""
+    reach (issue 22's rule before defect 4, cheaper per pixel); incidence_window False:
+    incidences from each pixel's nearest neighbours only (incidence_window_radius_px 0)."""
     import downstream_perception as dp
 
     config = dp.TsdfConfig()
@@ -60,6 +62,8 @@ def ours(
     if rule_before_defect_4:
         config.edge_guard_rule = dp.TsdfEdgeGuardRule.FIXED_RADIUS
         config.grazing_reach_voxels = 0.0
+    if not incidence_window:
+        config.incidence_window_radius_px = 0
     tsdf = dp.Tsdf(config)
     pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
     elapsed = timed_frames(tsdf.integrate_depth, depths, pinhole, poses)
@@ -204,6 +208,7 @@ def main() -> None:
     integrators: dict[str, Integrator] = {
         "downstream_perception": ours,
         "ours, fixed-radius guard": lambda d, p, c: ours(d, p, c, rule_before_defect_4=True),
+        "ours, no incidence window": lambda d, p, c: ours(d, p, c, incidence_window=False),
         "Open3D tensor": open3d_tensor,
         "Open3D legacy": open3d_legacy,
     }

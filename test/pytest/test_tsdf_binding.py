@@ -145,6 +145,37 @@ def fused_mesh(config: dp.TsdfConfig, cam: DepthCamera, poses: list, depths: lis
     return tsdf, tsdf.mesh()
 
 
+def scores_by_setting(
+    name: str,
+    values: tuple,
+    cam: DepthCamera,
+    scene: object,
+    poses: list,
+    depths: list,
+    observed: np.ndarray,
+) -> dict:
+    """tsdf_eval scores (2 cm) of the meshes fused from the frames with TsdfConfig's `name` set to
+    each of `values`, by value."""
+    scores = {}
+    for value in values:
+        config = dp.TsdfConfig()
+        setattr(config, name, value)
+        _, mesh = fused_mesh(config, cam, poses, depths)
+        scores[value] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
+    return scores
+
+
+def offset_room(offset: tuple[float, float, float]) -> tuple:
+    """The accuracy benchmark's room moved by `offset` (m), cameras and all: its 320x240 camera,
+    the scene, the 30 poses, their depths and the samples of the surface they observe."""
+    from downstream_perception.sim.scenes import accuracy_scene
+
+    cam = DepthCamera()
+    scene, poses = accuracy_scene("room", offset, 30)
+    depths = [cam.render(scene, pose) for pose in poses]
+    return cam, scene, poses, depths, observed_samples(scene, cam, poses, depths)
+
+
 def room_tsdf_5cm() -> dp.Tsdf:
     """The room fused from its 320x240 frames at 5 cm voxels."""
     cam, _, poses, depths, _ = room_frames("qvga")
@@ -217,13 +248,8 @@ def test_room_mesh_accuracy(image: str, voxel: float, dropoff: bool | None, tmp_
 def test_edge_guard_removes_ghosts() -> None:
     # Without the edge guard, rays grazing the box and table rims write "inside" values into the
     # free space beyond their edges: several times more ghost vertices.
-    cam, scene, poses, depths, observed = room_frames("qvga")
-    ghosts = {}
-    for guard in (0.0, 0.0075):
-        config = dp.TsdfConfig()
-        config.edge_guard_rad = guard
-        _, mesh = fused_mesh(config, cam, poses, depths)
-        ghosts[guard] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
+    frames = room_frames("qvga")
+    ghosts = scores_by_setting("edge_guard_rad", (0.0, 0.0075), *frames)
     assert ghosts[0.0075].ghost_fraction * 3 < ghosts[0.0].ghost_fraction
     assert ghosts[0.0075].completeness > ghosts[0.0].completeness - 0.002
 
@@ -291,14 +317,9 @@ def test_unconfirmed_voxels_keep_the_table_tops_underside_clean() -> None:
     # "inside" values under it meshed a skirt below its underside (0.11 % ghosts at this offset).
     # confirm_depth_voxels keeps voxels only ever seen that deep out of the mesh; sample() still
     # reads them, with a non-negative weight.
-    from downstream_perception.sim.scenes import accuracy_scene
-
     assert dp.TsdfConfig().confirm_depth_voxels == 2.5
-    cam = DepthCamera()
     offset = (0.015, 0.015, 0.015)
-    scene, poses = accuracy_scene("room", offset, 30)
-    depths = [cam.render(scene, pose) for pose in poses]
-    observed = observed_samples(scene, cam, poses, depths)
+    cam, scene, poses, depths, observed = offset_room(offset)
     scores = {}
     for confirm in (0.0, 2.5):
         config = dp.TsdfConfig()
@@ -581,22 +602,13 @@ def test_the_incidence_window_keeps_the_table_top_clean_under_depth_noise() -> N
     # the cosine 0.4 on a plane), so updates deep under the table top looked shallow and
     # confirmed its skirt again (0.11 % ghosts on the benchmark's frames). The plane of an
     # 11 x 11 window (incidence_window_radius_px 5) removes it without costing surface.
-    from downstream_perception.sim.scenes import accuracy_scene
-
     assert dp.TsdfConfig().incidence_window_radius_px == 5
-    cam = DepthCamera()
-    offset = (0.015, 0.015, 0.015)
-    scene, poses = accuracy_scene("room", offset, 30)
-    clean = [cam.render(scene, pose) for pose in poses]
-    observed = observed_samples(scene, cam, poses, clean)
+    cam, scene, poses, clean, observed = offset_room((0.015, 0.015, 0.015))
     rng = np.random.default_rng(5)
     noisy = [(d + rng.normal(0.0, 0.005, d.shape)).astype(np.float32) for d in clean]
-    scores = {}
-    for radius in (0, 5):
-        config = dp.TsdfConfig()
-        config.incidence_window_radius_px = radius
-        _, mesh = fused_mesh(config, cam, poses, noisy)
-        scores[radius] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.02, observed)
+    scores = scores_by_setting(
+        "incidence_window_radius_px", (0, 5), cam, scene, poses, noisy, observed
+    )
     assert scores[0].ghost_fraction > 0.0005
     assert scores[5].ghost_fraction < 0.0005
     assert scores[5].completeness > scores[0].completeness - 0.0005

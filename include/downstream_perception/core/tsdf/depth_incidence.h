@@ -1,5 +1,6 @@
 // The angle at which each pixel's ray meets the surface it sees, estimated from a depth image:
-// the rim distance rule, the grazing reach and unconfirmed voxels of the TSDF integrator read it.
+// the TSDF integrator's rim distance rule, grazing reach, fixed-radius relief and unconfirmed
+// voxels read it.
 #pragma once
 
 #include <cstdint>
