@@ -103,11 +103,11 @@ struct TsdfConfig {
   double grazing_reach_max_voxels = 16.0;
   /// Depth images: the incidences (above, and confirm_depth_voxels) are read from the plane of
   /// the (2 r + 1)^2 pixels around each pixel where all of them continue one surface (depths
-  /// within mu pair by pair), else from a window of half the radius, then of radius 1, else from
-  /// the pixel's nearest neighbours. A pixel's own neighbours see depth noise over a baseline of
-  /// one pixel: with 5 mm of it the table top's skirt and rim ghosts came back (640x480, 2 cm:
-  /// ghosts median 0.056 -> 0.013 %, the worst case 0.38 -> 0.10 %; docs/tsdf.md). Clean
-  /// frames mesh as before within 0.0001 of completeness. 0 = off (nearest neighbours only).
+  /// within two voxels, at most mu, pair by pair), else from a window of half the radius, then of
+  /// radius 1, else from the pixel's nearest neighbours. A pixel's own neighbours see depth noise
+  /// over a baseline of one pixel: with 5 mm of it the table top's skirt and rim ghosts came back
+  /// (640x480, 2 cm: ghosts median 0.056 -> 0.013 %, the worst case 0.38 -> 0.10 %; docs/tsdf.md).
+  /// Clean frames mesh as before within 0.0001 of completeness. 0 = off (nearest neighbours only).
   int incidence_window_radius_px = 5;
   /// Depth images: read each voxel's depth by interpolating inverse depth between the four
   /// nearest pixels (exact on planes) instead of taking the nearest pixel; falls back to the
