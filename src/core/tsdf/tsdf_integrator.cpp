@@ -161,17 +161,61 @@ void computeRangePerDepth(const PinholeCamera& camera, DepthFrame* f) {
   f->camera = camera;
 }
 
-/// Whether neighbouring pixels a = i - step, i, j = i + step, b = j + step lie on one plane
-/// within `tol` (m), judged from either side: on a plane inverse depth is affine along an image
-/// line, so 2 / d_i - 1 / d_a predicts 1 / d_j (and 2 / d_j - 1 / d_b predicts 1 / d_i). A zero
-/// inverse depth (invalid pixel, or none outside the image) predicts nothing.
-DP_INTEGRATION_STEP bool onOnePlane(float inv_a, float inv_i, float inv_j, float inv_b, float d_i,
-                                    float d_j, float tol) {
-  const float p_j = 2.0f * inv_i - inv_a;
-  const float p_i = 2.0f * inv_j - inv_b;
-  const bool from_i = (inv_a != 0.0f) & (p_j > 0.0f) & (std::abs(d_j * p_j - 1.0f) <= tol * p_j);
-  const bool from_j = (inv_b != 0.0f) & (p_i > 0.0f) & (std::abs(d_i * p_i - 1.0f) <= tol * p_i);
-  return from_i | from_j;
+/// Which neighbours of a pixel pair (i, j = i + step) along an image line are in the image:
+/// a = i - step, b = j + step, a2 = i - 2 step, c = j + 2 step.
+struct PairNeighbours {
+  bool a, b, a2, c;
+};
+
+/// Whether 1 / d predicted by an inverse depth `predicted` (> 0) lies within `tol` (m) of d.
+DP_INTEGRATION_STEP bool predicts(float predicted, float d, float tol) {
+  return (predicted > 0.0f) & (std::abs(d * predicted - 1.0f) <= tol * predicted);
+}
+
+/// Whether a step of more than the jump between neighbouring pixels i and j = i + step (both
+/// valid) continues one surface. On a plane inverse depth is affine along an image line, so
+/// from a = i - step, 2 / d_i - 1 / d_a predicts 1 / d_j (from_i), and from b = j + step,
+/// 2 / d_j - 1 / d_b predicts 1 / d_i (from_j); a zero inverse depth (invalid, or outside the
+/// image) predicts nothing. One prediction within `tol` (m) is a surface seen at grazing
+/// incidence, which steps by more than the jump per pixel far away, unless the step is an
+/// occluding edge after all: the side that continues is the nearer one, the farther pixel lies
+/// beyond its prediction (that surface, continued, would have met the farther pixel's ray
+/// first: it ends between the two rays), and the farther pixel's own side (it and its next two
+/// pixels) forms a plane that predicts it better than the continuation does. A board a few
+/// centimetres in front of a wall, seen at grazing incidence, steps by more than the gap per
+/// pixel, so the wall's pixels continue the board's plane within tol; without this test its far
+/// edge was no rim and the board's truncation band ran on into the gap behind it (issue 22:
+/// ghosts 0.09 % of the furnished room's mesh at 640x480). A concave corner (a wall seen at
+/// grazing meeting the wall across) keeps its reach: the wall across lies before the grazing
+/// wall's continuation, and the grazing wall's last pixel, at the corner, is predicted by both
+/// planes but exactly only by its own.
+DP_INTEGRATION_STEP bool continuesSurface(const float* inv, const float* dep, std::size_t i,
+                                          std::size_t step, const PairNeighbours& has, float tol) {
+  const std::size_t j = i + step;
+  const float inv_a = has.a ? inv[i - step] : 0.0f;
+  const float inv_b = has.b ? inv[j + step] : 0.0f;
+  const float d_i = dep[i], d_j = dep[j];
+  const float p_j = 2.0f * inv[i] - inv_a;
+  const float p_i = 2.0f * inv[j] - inv_b;
+  const bool from_i = (inv_a != 0.0f) & predicts(p_j, d_j, tol);
+  const bool from_j = (inv_b != 0.0f) & predicts(p_i, d_i, tol);
+  if (from_i == from_j) return from_i;
+  // One side continues: the near side (a, i) when from_i, with j its farther neighbour; else
+  // the near side is (b, j) and i the farther pixel.
+  if (from_i) {
+    const float inv_c = has.c ? inv[j + 2 * step] : 0.0f;
+    const bool ended = (d_i < d_j) & (d_j * p_j > 1.0f);
+    const float q = 2.0f * inv_b - inv_c;
+    const bool far_plane = (inv_b != 0.0f) & (inv_c != 0.0f) & (q > 0.0f) &
+                           (std::abs(d_j * q - 1.0f) < std::abs(d_j * p_j - 1.0f));
+    return !(ended & far_plane);
+  }
+  const float inv_a2 = has.a2 ? inv[i - 2 * step] : 0.0f;
+  const bool ended = (d_j < d_i) & (d_i * p_i > 1.0f);
+  const float q = 2.0f * inv_a - inv_a2;
+  const bool far_plane = (inv_a != 0.0f) & (inv_a2 != 0.0f) & (q > 0.0f) &
+                         (std::abs(d_i * q - 1.0f) < std::abs(d_i * p_i - 1.0f));
+  return !(ended & far_plane);
 }
 
 /// Dilates `edge` (w x h bytes) by `radius` pixels (a separable box) into f->near_edge: each
@@ -241,10 +285,10 @@ DP_INTEGRATION_STEP void spreadOverNearSide(int w, int h, float jump, int radius
 
 /// The rims (seeds) of the edge guard, into f->edge. Two neighbouring pixels (along a row or a
 /// column) are a depth discontinuity when one is not a valid depth (NaN, +Inf) or their depths
-/// differ by more than `jump` (m) and they are not onOnePlane within jump / 2 (a surface seen at
-/// a grazing angle far away steps by more than mu from pixel to pixel, but continues its
-/// neighbours' plane: no rim there). near_side_only: the nearer pixel of a discontinuity (the
-/// valid one next to an invalid one) is a seed; else both valid pixels are.
+/// differ by more than `jump` (m) and the step does not continuesSurface within jump / 2 (a
+/// surface seen at a grazing angle far away steps by more than mu from pixel to pixel, but
+/// continues its neighbours' plane: no rim there). near_side_only: the nearer pixel of a
+/// discontinuity (the valid one next to an invalid one) is a seed; else both valid pixels are.
 DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only, DepthFrame* f) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
   f->edge.assign(n, 0);
@@ -252,15 +296,13 @@ DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only,
   const float* dep = f->depth.data();
   std::uint8_t* edge = f->edge.data();
   const float tol = 0.5f * jump;
-  // The pair (i, i + step); has_a / has_b: whether i - step and i + 2 step are in the image.
-  const auto pair = [&](std::size_t i, std::size_t step, bool has_a, bool has_b) {
+  // The pair (i, i + step); `has`: which of its outer neighbours are in the image.
+  const auto pair = [&](std::size_t i, std::size_t step, const PairNeighbours& has) {
     const std::size_t j = i + step;
     const float di = dep[i], dj = dep[j];
     const bool vi = inv[i] != 0.0f, vj = inv[j] != 0.0f;
     if (std::abs(dj - di) <= jump) return;  // false for NaN and +Inf: they differ
-    const float inv_a = has_a ? inv[i - step] : 0.0f;
-    const float inv_b = has_b ? inv[j + step] : 0.0f;
-    if (vi & vj && onOnePlane(inv_a, inv[i], inv[j], inv_b, di, dj, tol)) return;
+    if (vi & vj && continuesSurface(inv, dep, i, step, has, tol)) return;
     if (near_side_only) {
       edge[i] |= vi & (!vj | (dj > di));
       edge[j] |= vj & (!vi | (di > dj));
@@ -270,18 +312,18 @@ DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only,
     }
   };
   for (int v = 0; v < h; ++v) {
-    for (int u = 0; u + 1 < w; ++u) pair(static_cast<std::size_t>(v) * w + u, 1, u > 0, u + 2 < w);
+    for (int u = 0; u + 1 < w; ++u) {
+      pair(static_cast<std::size_t>(v) * w + u, 1, {u > 0, u + 2 < w, u > 1, u + 3 < w});
+    }
   }
   for (int v = 0; v + 1 < h; ++v) {
     for (int u = 0; u < w; ++u) {
-      pair(static_cast<std::size_t>(v) * w + u, static_cast<std::size_t>(w), v > 0, v + 2 < h);
+      pair(static_cast<std::size_t>(v) * w + u, static_cast<std::size_t>(w),
+           {v > 0, v + 2 < h, v > 1, v + 3 < h});
     }
   }
 }
 
-/// kFixedRadius: the guard's mask f->near_edge. The rims (markRims) spread by `radius` pixels:
-/// near_side_only, only over pixels not more than `jump` farther (spreadOverNearSide); else to
-/// every pixel within `radius` (the guard before issue 22's defect 4).
 DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, bool near_side_only,
                                        DepthFrame* f) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
