@@ -16,8 +16,9 @@ surface is what the clean frames saw.
 
 Output: a markdown table per (image, voxel, noise, integrator) of the median (min-max) over
 scenes x offsets of mean and p95 |SDF| at the vertices (mm), ghosts (% of vertices more than a
-voxel off every surface) and completeness (observed surface within 2 cm of the mesh); --json
-writes every score.
+voxel off every surface) and completeness (observed surface within 2 cm of the mesh); then, per
+case against Open3D legacy (issue 22's goal), how often completeness is at or above legacy's,
+ghosts under 0.05 %, and both; --json writes every score.
 
 Usage: make bench-tsdf-accuracy   (or: python3 bench/bench_tsdf_accuracy.py [--quick]; --quick: a
 half-size 320x240 camera (same field of view), 5 cm, 2 scenes, 2 offsets, 8 frames; subsets:
@@ -362,6 +363,59 @@ def markdown(summary: dict[tuple[str, float, str, str], dict[str, Any]], title: 
     return lines
 
 
+GHOST_GOAL_PCT = 0.05  # issue 22's goal: ghosts under 0.05 % with legacy's completeness
+
+
+def against(
+    scores: Sequence[Score], reference: str = "Open3D legacy"
+) -> dict[tuple[str, float, str, str], dict[str, int]]:
+    """Per (image, voxel, noise, integrator other than `reference`): in how many of its cases
+    (scene x offset, the same frames) completeness is at or above the reference's, ghosts are
+    under GHOST_GOAL_PCT, and both; only cases the reference scored too."""
+    ref = {
+        (s.image, s.voxel_m, s.noise, s.scene, s.offset_voxels): s
+        for s in scores
+        if s.integrator == reference
+    }
+    counts: dict[tuple[str, float, str, str], dict[str, int]] = {}
+    for s in scores:
+        r = ref.get((s.image, s.voxel_m, s.noise, s.scene, s.offset_voxels))
+        if s.integrator == reference or r is None:
+            continue
+        entry = counts.setdefault(
+            (s.image, s.voxel_m, s.noise, s.integrator),
+            {"cases": 0, "complete": 0, "ghosts": 0, "both": 0},
+        )
+        complete = s.completeness >= r.completeness
+        clean = s.ghost_pct < GHOST_GOAL_PCT
+        entry["cases"] += 1
+        entry["complete"] += complete
+        entry["ghosts"] += clean
+        entry["both"] += complete and clean
+    return counts
+
+
+def against_markdown(
+    counts: dict[tuple[str, float, str, str], dict[str, int]], reference: str = "Open3D legacy"
+) -> list[str]:
+    if not counts:
+        return []
+    lines = [
+        f"Per case against {reference} (same frames): completeness at or above its, ghosts "
+        f"under {GHOST_GOAL_PCT:g} %, both.",
+        "",
+        "| image, voxel | noise | integrator | cases | complete ≥ | ghosts < | both |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for (image, voxel, noise, name), e in counts.items():
+        lines.append(
+            f"| {image}, {100 * voxel:.0f} cm | {noise} | {name} | {e['cases']} | "
+            f"{e['complete']} | {e['ghosts']} | {e['both']} |"
+        )
+    lines.append("")
+    return lines
+
+
 def main() -> None:
     from downstream_perception.sim.scenes import ACCURACY_SCENES
 
@@ -429,7 +483,7 @@ def main() -> None:
         f"TSDF accuracy over scenes ({', '.join(scenes)}) and lattice offsets "
         f"({', '.join(f'{f:g}' for f in offsets)} voxel), {frames} frames, truncation 4 voxels"
     )
-    print("\n".join(markdown(summarise(scores), title)))
+    print("\n".join(markdown(summarise(scores), title) + against_markdown(against(scores))))
     print(f"({time.perf_counter() - t0:.0f} s)")
 
 

@@ -88,6 +88,32 @@ def test_summary_gives_median_and_range_over_scenes_and_offsets(bench: Any) -> N
     assert "| 320x240, 5 cm | clean | ours | 3 | 2.00 (1.00–4.00) | 4.0 (2.0–8.0) |" in table
 
 
+def test_cases_are_counted_against_legacy_on_the_same_frames(bench: Any) -> None:
+    def score(integrator: str, scene: str, ghost_pct: float, completeness: float) -> Any:
+        return bench.Score("320x240", 0.02, "clean", integrator, scene, 0.0, 10, 1.0, 2.0,
+                           ghost_pct, completeness)  # fmt: skip
+
+    scores = [
+        score("Open3D legacy", "a", 0.4, 0.999),
+        score("Open3D legacy", "b", 0.4, 0.990),
+        score("ours", "a", 0.01, 0.998),  # less complete
+        score("ours", "b", 0.01, 0.990),  # as complete, few ghosts: meets the goal
+        score("ours", "c", 0.00, 1.000),  # no legacy case: not counted
+        score("Open3D tensor", "a", 0.06, 0.999),  # as complete, too many ghosts
+    ]
+    counts = bench.against(scores)
+    assert counts[("320x240", 0.02, "clean", "ours")] == {
+        "cases": 2, "complete": 1, "ghosts": 2, "both": 1,
+    }  # fmt: skip
+    assert counts[("320x240", 0.02, "clean", "Open3D tensor")] == {
+        "cases": 1, "complete": 1, "ghosts": 0, "both": 0,
+    }  # fmt: skip
+    assert ("320x240", 0.02, "clean", "Open3D legacy") not in counts
+    table = "\n".join(bench.against_markdown(counts))
+    assert "| 320x240, 2 cm | clean | ours | 2 | 1 | 2 | 1 |" in table
+    assert bench.against_markdown(bench.against(scores[2:3])) == []
+
+
 def test_near_mesh_matches_sampling_every_triangle(bench: Any, room: tuple) -> None:
     # score_mesh's completeness checks vertices first and samples only the triangles that could
     # matter: the same answer as sampling the whole mesh.
