@@ -28,26 +28,30 @@ inline std::vector<float> planeDepth(const PinholeCamera& camera, const Eigen::V
   return depth;
 }
 
+/// A width x height camera with focal length f (px), its principal point at the image's centre.
+inline PinholeCamera centredCamera(int width, int height, double f) {
+  PinholeCamera c;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = f;
+  c.cx = 0.5 * (width - 1);
+  c.cy = 0.5 * (height - 1);
+  return c;
+}
+
 /// 160 x 120, f = 150 px.
 inline PinholeCamera smallCamera() {
-  PinholeCamera c;
-  c.width = 160;
-  c.height = 120;
-  c.fx = c.fy = 150.0;
-  c.cx = 79.5;
-  c.cy = 59.5;
-  return c;
+  return centredCamera(160, 120, 150.0);
 }
 
 /// The accuracy benchmark's 320 x 240 camera (f = 262.5 px).
 inline PinholeCamera benchmarkCamera() {
-  PinholeCamera c;
-  c.width = 320;
-  c.height = 240;
-  c.fx = c.fy = 262.5;
-  c.cx = 159.5;
-  c.cy = 119.5;
-  return c;
+  return centredCamera(320, 240, 262.5);
+}
+
+/// The accuracy benchmark's 640 x 480 camera (f = 525 px).
+inline PinholeCamera vgaCamera() {
+  return centredCamera(640, 480, 525.0);
 }
 
 /// Whether some frame saw world point p: its depth at p's nearest pixel matches p's within 1 cm
