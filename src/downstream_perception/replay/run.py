@@ -281,7 +281,12 @@ class NodeletRun:
             result.costmap = self._final_costmap()
         if self.pipeline.capability("tsdf"):
             result.saved = self._save_tsdf()
-        time.sleep(1.0)  # one more diagnostics round
+        # One more diagnostics round: the nodelets publish theirs on simulated time (at most
+        # once per simulated second), so the clock moves on by more than that.
+        end_s = s.end_s + steps * 0.05
+        for k in range(1, 25):
+            self._publish_clock(end_s + k * 0.05)
+            time.sleep(0.05)
         result.diagnostics = dict(self.diagnostics)
         if self.tracks is not None:
             self.tracks.close()

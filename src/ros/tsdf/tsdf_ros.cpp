@@ -46,6 +46,9 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   output_directory_ = readOutputDirectory(pnh_, &config_errors_);
   const TsdfNodeSettings settings = readTsdfNodeSettings(pnh_, &config_errors_);
   health_period_s_ = settings.health_period_s;
+  // Images early for their CameraInfo wait as many as wait for tf.
+  tf_queue_size_ = static_cast<std::size_t>(settings.tf_queue_size);
+  camera_infos_ = CameraInfoCache(tf_queue_size_);
   slice_ = settings.slice;
   slice_distance_max_m_ = settings.slice_distance_max_m;
   slice_window_ = settings.slice_window;
@@ -216,8 +219,12 @@ bool TsdfRos::lookup(const std_msgs::Header& header, Eigen::Isometry3d* T, std::
 }
 
 void TsdfRos::onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  camera_infos_[msg->header.frame_id] = *msg;
+  std::vector<sensor_msgs::ImageConstPtr> waited;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    waited = camera_infos_.update(*msg);
+  }
+  for (const auto& image : waited) acceptDepth(image);
 }
 
 void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
@@ -237,18 +244,17 @@ void TsdfRos::account(const TsdfIntegrationStats& stats, double elapsed_ms) {
 
 bool TsdfRos::cameraFor(const sensor_msgs::Image& image, PinholeCamera* camera, std::string* why) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = camera_infos_.find(image.header.frame_id);
-  if (it == camera_infos_.end()) {
+  const sensor_msgs::CameraInfo* info = camera_infos_.find(image.header.frame_id);
+  if (info == nullptr) {
     *why = "no CameraInfo yet for frame '" + image.header.frame_id + "'";
     return false;
   }
-  if (it->second.width != image.width || it->second.height != image.height) {
+  if (info->width != image.width || info->height != image.height) {
     *why = "image " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-           " but CameraInfo " + std::to_string(it->second.width) + "x" +
-           std::to_string(it->second.height);
+           " but CameraInfo " + std::to_string(info->width) + "x" + std::to_string(info->height);
     return false;
   }
-  const auto& K = it->second.K;
+  const auto& K = info->K;
   *camera = PinholeCamera{
       K[0], K[4], K[2], K[5], static_cast<int>(image.width), static_cast<int>(image.height)};
   *why = camera->validate();
@@ -261,10 +267,31 @@ void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
     return;
   }
   std::string why;
-  PinholeCamera camera;
   if (!checkDepthImage(*msg, &why)) {  // converted once, after tf, in onDepth()
     rejected_.reject("bad depth image", why);
-  } else if (!cameraFor(*msg, &camera, &why)) {
+    return;
+  }
+  sensor_msgs::ImageConstPtr dropped;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (camera_infos_.find(msg->header.frame_id) == nullptr) {
+      dropped = camera_infos_.wait(msg);  // until its frame's first CameraInfo
+      if (dropped == nullptr) return;
+    }
+  }
+  if (dropped != nullptr) {
+    rejected_.reject("camera_info missing or inconsistent",
+                     "no CameraInfo for frame '" + dropped->header.frame_id + "' while " +
+                         std::to_string(tf_queue_size_) + " images waited for one");
+    return;
+  }
+  acceptDepth(msg);
+}
+
+void TsdfRos::acceptDepth(const sensor_msgs::ImageConstPtr& msg) {
+  std::string why;
+  PinholeCamera camera;
+  if (!cameraFor(*msg, &camera, &why)) {
     rejected_.reject("camera_info missing or inconsistent", why);
   } else {
     depth_filter_.add(msg);

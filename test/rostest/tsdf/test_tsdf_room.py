@@ -19,8 +19,10 @@ from collections.abc import Callable
 import numpy as np
 import rospy
 import rostest
+import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray
 from dynamic_reconfigure.client import Client as ReconfigureClient
+from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import OccupancyGrid
 from sensor_msgs import point_cloud2
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
@@ -396,6 +398,40 @@ class TsdfRoomTest(unittest.TestCase):
             f"diagnostics: {self.status}",
         )
         self.assertEqual(int(self.status["frames integrated"]), 20)
+
+    def test_3b_an_image_before_its_first_camera_info_waits_for_it(self) -> None:
+        # Image and CameraInfo travel on separate connections: at start-up (or in a replay) the
+        # first image can arrive first. It waits for its frame's CameraInfo, then is fused.
+        images = rospy.Publisher("/depth/image", Image, queue_size=5)
+        infos = rospy.Publisher("/depth/camera_info", CameraInfo, queue_size=5)
+        self.assertTrue(wait_until(lambda: images.get_num_connections() > 0, 5.0))
+        self.assertTrue(wait_until(lambda: infos.get_num_connections() > 0, 5.0))
+        self.assertTrue(wait_until(lambda: "frames integrated" in self.status, 10.0))
+        before = int(self.status["frames integrated"])
+        stamp = rospy.Time.now()
+        pose = TransformStamped(header=Header(stamp=stamp, frame_id="odom"))
+        pose.child_frame_id = "late_optical"
+        pose.transform.translation.z = 1.0
+        pose.transform.rotation.w = 1.0
+        broadcaster = tf2_ros.TransformBroadcaster()
+        time.sleep(0.5)  # the nodelet's tf listener connects to this node's /tf
+        broadcaster.sendTransform(pose)
+        depth = Image(header=Header(stamp=stamp, frame_id="late_optical"), height=4, width=4)
+        depth.encoding, depth.step = "32FC1", 16
+        depth.data = np.full((4, 4), 1.5, np.float32).tobytes()
+        images.publish(depth)
+        key = "depth images waiting for their first CameraInfo"
+        self.assertTrue(wait_until(lambda: self.status.get(key) == "1", 5.0), self.status)
+        self.assertEqual(int(self.status["frames integrated"]), before, self.status)
+        k = [4.0, 0.0, 1.5, 0.0, 4.0, 1.5, 0.0, 0.0, 1.0]
+        infos.publish(
+            CameraInfo(header=Header(stamp=stamp, frame_id="late_optical"), width=4, height=4, K=k)
+        )
+        self.assertTrue(
+            wait_until(lambda: int(self.status.get("frames integrated", 0)) == before + 1, 5.0),
+            self.status,
+        )
+        self.assertEqual(self.status[key], "0")
 
     def test_4_clear_empties_the_map(self) -> None:
         rospy.wait_for_service("/tsdf/clear", 5.0)

@@ -37,6 +37,7 @@
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
+#include "downstream_perception/ros/common/camera_info_cache.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
 #include "downstream_perception/ros/common/reconfigure_host.h"
@@ -55,7 +56,9 @@ class TsdfRos {
  private:
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg);
   void onDepthRaw(const sensor_msgs::ImageConstPtr& msg);  ///< checks, then waits for tf
-  void onDepth(const sensor_msgs::ImageConstPtr& msg);     ///< tf available: integrates
+  /// A checked image whose frame has a CameraInfo: checked against it, then waits for tf.
+  void acceptDepth(const sensor_msgs::ImageConstPtr& msg);
+  void onDepth(const sensor_msgs::ImageConstPtr& msg);  ///< tf available: integrates
   void onCloudRaw(const sensor_msgs::PointCloud2ConstPtr& msg);
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg);
   /// The pinhole model for an image from the latest CameraInfo of its frame, or why not.
@@ -100,7 +103,8 @@ class TsdfRos {
   DepthIntegrator integrator_;     ///< keeps the per-pixel buffers between frames
   TsdfMesher mesher_;
   TsdfMeshMarkers markers_;
-  std::map<std::string, sensor_msgs::CameraInfo> camera_infos_;  ///< latest per frame id
+  CameraInfoCache camera_infos_{0};  ///< latest per frame id; images early for theirs wait
+  std::size_t tf_queue_size_ = 10;   ///< ~tf_queue_size
 
   std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
