@@ -172,6 +172,19 @@ DP_INTEGRATION_STEP bool predicts(float predicted, float d, float tol) {
   return (predicted > 0.0f) & (std::abs(d * predicted - 1.0f) <= tol * predicted);
 }
 
+/// continuesSurface's occluding-edge test, for a near pixel (depth d_near) whose side's plane
+/// predicts the inverse depth p_far for the farther pixel (depth d_far) across the step: the
+/// farther pixel lies beyond that continuation, and the plane of its own side (its next two
+/// pixels' inverse depths inv_f1, inv_f2; 0: invalid or outside the image) predicts it better.
+DP_INTEGRATION_STEP bool endsBetweenRays(float d_near, float d_far, float p_far, float inv_f1,
+                                         float inv_f2) {
+  const bool ended = (d_near < d_far) & (d_far * p_far > 1.0f);
+  const float q = 2.0f * inv_f1 - inv_f2;
+  const bool far_plane = (inv_f1 != 0.0f) & (inv_f2 != 0.0f) & (q > 0.0f) &
+                         (std::abs(d_far * q - 1.0f) < std::abs(d_far * p_far - 1.0f));
+  return ended & far_plane;
+}
+
 /// Whether a step of more than the jump between neighbouring pixels i and j = i + step (both
 /// valid) continues one surface. On a plane inverse depth is affine along an image line, so
 /// from a = i - step, 2 / d_i - 1 / d_a predicts 1 / d_j (from_i), and from b = j + step,
@@ -200,22 +213,10 @@ DP_INTEGRATION_STEP bool continuesSurface(const float* inv, const float* dep, st
   const bool from_i = (inv_a != 0.0f) & predicts(p_j, d_j, tol);
   const bool from_j = (inv_b != 0.0f) & predicts(p_i, d_i, tol);
   if (from_i == from_j) return from_i;
-  // One side continues: the near side (a, i) when from_i, with j its farther neighbour; else
-  // the near side is (b, j) and i the farther pixel.
-  if (from_i) {
-    const float inv_c = has.c ? inv[j + 2 * step] : 0.0f;
-    const bool ended = (d_i < d_j) & (d_j * p_j > 1.0f);
-    const float q = 2.0f * inv_b - inv_c;
-    const bool far_plane = (inv_b != 0.0f) & (inv_c != 0.0f) & (q > 0.0f) &
-                           (std::abs(d_j * q - 1.0f) < std::abs(d_j * p_j - 1.0f));
-    return !(ended & far_plane);
-  }
-  const float inv_a2 = has.a2 ? inv[i - 2 * step] : 0.0f;
-  const bool ended = (d_j < d_i) & (d_i * p_i > 1.0f);
-  const float q = 2.0f * inv_a - inv_a2;
-  const bool far_plane = (inv_a != 0.0f) & (inv_a2 != 0.0f) & (q > 0.0f) &
-                         (std::abs(d_i * q - 1.0f) < std::abs(d_i * p_i - 1.0f));
-  return !(ended & far_plane);
+  // One side continues: the near side (a, i) when from_i, with j the farther pixel and (b, c)
+  // its own side; else the near side is (b, j), i the farther pixel and (a, a2) its side.
+  if (from_i) return !endsBetweenRays(d_i, d_j, p_j, inv_b, has.c ? inv[j + 2 * step] : 0.0f);
+  return !endsBetweenRays(d_j, d_i, p_i, inv_a, has.a2 ? inv[i - 2 * step] : 0.0f);
 }
 
 /// Dilates `edge` (w x h bytes) by `radius` pixels (a separable box) into f->near_edge: each
