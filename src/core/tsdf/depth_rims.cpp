@@ -157,40 +157,12 @@ void rimAllowances(const float* depth, const float* inverse, const std::uint8_t*
   const float* squared_px = distances->squared.data();
   const float* rim_depth = planes[0].data();
   const float* rim_cosine = planes[1].data();
-  const float fallback_squared = s.fallback_radius_px * s.fallback_radius_px;
-  // The settings in locals: the stores below could otherwise alias them for the compiler.
-  const float voxel = s.voxel, mu = s.truncation, reach_per_cos = s.reach, reach_max = s.reach_max;
-  const float jump = s.jump;
+  // The settings in a local copy: the stores below could otherwise alias them for the compiler.
+  const RimAllowanceSettings local = s;
   const float scale = s.rim_scale * metres_per_px;
-  const float radians_per_px = s.radians_per_px;
-  const float margin = kSilhouetteSineMargin;
-  const bool reaching = s.reach > 0.0f;
   for (std::size_t i = 0; i < pixels; ++i) {
-    const float squared = squared_px[i], z = depth[i], c = cosine[i];
-    const float rim_z = rim_depth[i], rc = rim_cosine[i];
-    const bool is_seed = seeds[i] != 0, valid = inverse[i] != 0.0f;
-    // The nearest rim counts only if this pixel is on its object (not the background beside
-    // it, more than jump farther).
-    const bool near_rim = (squared < SeedDistances::kNoSeed) & (z <= rim_z + jump);
-    const float reach =
-        reaching & (c > 0.0f) ? std::min(reach_max, std::max(mu, reach_per_cos / c)) : mu;
-    const float sine = std::sqrt(std::max(0.0f, 1.0f - c * c));
-    // A rim seen more grazing than the pixel (unknown incidence: grazing) ends a surface that
-    // turns towards the line of sight: the silhouette of a convex surface, behind which the ray
-    // leaves no earlier than at the silhouette's depth, sine (1 + sine) times the plane's travel
-    // (a sphere: half its chord 2 r cos against r (1 - sine) / (cos sine); issue 22). On a plane
-    // the incidences of two pixels differ by at most the angle between their rays (D px apart:
-    // D radians_per_px), so only a rim more grazing than that (and the estimate's noise) turns.
-    const float distance_px = std::sqrt(squared);
-    const float rim_sine = rc < 0.0f ? 1.0f : std::sqrt(std::max(0.0f, 1.0f - rc * rc));
-    // (Only read where near_rim: and-ing it in here kept the AVX2 copy from vectorising.)
-    const bool turning = rim_sine > sine + distance_px * radians_per_px + margin;
-    const float factor = turning ? std::max(1.0f, sine * (1.0f + sine)) : 1.0f;
-    const float travel = factor * scale * distance_px * z / std::max(c * sine, 1e-6f);
-    float a = near_rim ? std::min(reach, std::max(voxel, travel)) : reach;
-    a = c < 0.0f ? (near_rim & (squared <= fallback_squared) ? voxel : mu) : a;
-    a = is_seed ? voxel : a;
-    allowed[i] = valid ? a : mu;
+    allowed[i] = rimAllowance(squared_px[i], depth[i], cosine[i], rim_depth[i], rim_cosine[i],
+                              seeds[i] != 0, inverse[i] != 0.0f, scale, local);
   }
 }
 

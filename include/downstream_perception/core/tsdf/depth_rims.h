@@ -2,6 +2,8 @@
 // distance rule of the TSDF integrator (issue 22, defect 4), and the pieces it is made of.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
@@ -90,6 +92,39 @@ constexpr float kSilhouetteSineMargin = 0.02f;
 void rimAllowances(const float* depth, const float* inverse, const std::uint8_t* seeds,
                    SeedDistances* distances, const float* cosine, std::size_t pixels,
                    float metres_per_px, const RimAllowanceSettings& settings, float* allowed);
+
+/// One pixel of rimAllowances: squared_px its squared distance to the nearest rim
+/// (SeedDistances::kNoSeed: none), z its depth, c its incidence cosine (< 0: unknown), rim_z and
+/// rim_c the rim's, is_seed whether it is a rim itself, valid whether its depth is;
+/// scale = rim_scale * metres_per_px.
+[[gnu::always_inline]] inline float rimAllowance(float squared_px, float z, float c, float rim_z,
+                                                 float rim_c, bool is_seed, bool valid, float scale,
+                                                 const RimAllowanceSettings& s) {
+  // The nearest rim counts only if this pixel is on its object (not the background beside
+  // it, more than jump farther).
+  const bool near_rim = (squared_px < SeedDistances::kNoSeed) & (z <= rim_z + s.jump);
+  const float reach = (s.reach > 0.0f) & (c > 0.0f)
+                          ? std::min(s.reach_max, std::max(s.truncation, s.reach / c))
+                          : s.truncation;
+  const float sine = std::sqrt(std::max(0.0f, 1.0f - c * c));
+  // A rim seen more grazing than the pixel (unknown incidence: grazing) ends a surface that
+  // turns towards the line of sight: the silhouette of a convex surface, behind which the ray
+  // leaves no earlier than at the silhouette's depth, sine (1 + sine) times the plane's travel
+  // (a sphere: half its chord 2 r cos against r (1 - sine) / (cos sine); issue 22). On a plane
+  // the incidences of two pixels differ by at most the angle between their rays (D px apart:
+  // D radians_per_px), so only a rim more grazing than that (and the estimate's noise) turns.
+  const float distance_px = std::sqrt(squared_px);
+  const float rim_sine = rim_c < 0.0f ? 1.0f : std::sqrt(std::max(0.0f, 1.0f - rim_c * rim_c));
+  // (Only read where near_rim: and-ing it in here kept the AVX2 copy from vectorising.)
+  const bool turning = rim_sine > sine + distance_px * s.radians_per_px + kSilhouetteSineMargin;
+  const float factor = turning ? std::max(1.0f, sine * (1.0f + sine)) : 1.0f;
+  const float travel = factor * scale * distance_px * z / std::max(c * sine, 1e-6f);
+  float a = near_rim ? std::min(reach, std::max(s.voxel, travel)) : reach;
+  const float fallback_squared = s.fallback_radius_px * s.fallback_radius_px;
+  a = c < 0.0f ? (near_rim & (squared_px <= fallback_squared) ? s.voxel : s.truncation) : a;
+  a = is_seed ? s.voxel : a;
+  return valid ? a : s.truncation;
+}
 
 /// The grazing reach alone (no rims) at |cos(incidence)| `cosine`: min(reach_max, max(mu,
 /// reach / cosine)); mu where the incidence is unknown (cosine <= 0) or reach is 0.
