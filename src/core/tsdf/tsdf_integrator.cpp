@@ -116,9 +116,12 @@ struct DepthFrame {
   std::vector<float> column_x;              ///< scratch of incidenceCosines
   IncidenceWindowScratch incidence_window;  ///< scratch of windowIncidenceCosines
   std::vector<std::uint8_t> edge;           ///< scratch: the discontinuities' seeds
-  std::vector<std::uint8_t> rows;           ///< scratch: the seeds dilated along rows
-  std::vector<float> seed_depth;  ///< scratch: the seeds' depths, then their window minimum
-  std::vector<float> rows_depth;  ///< scratch: the seeds' depths' minimum along rows
+  /// The near sides of steps over mu that one side continues (markRims): rims for the far
+  /// grazing pixels' second look (grazingPlaneAllowances).
+  std::vector<std::uint8_t> soft_edge;
+  std::vector<std::uint8_t> rows;  ///< scratch: the seeds dilated along rows
+  std::vector<float> seed_depth;   ///< scratch: the seeds' depths, then their window minimum
+  std::vector<float> rows_depth;   ///< scratch: the seeds' depths' minimum along rows
   /// 1 where the 2 x 2 pixels from this one (right, down) are all valid depths within a voxel
   /// of each other: inverse depth may be interpolated between them. Checked once per pixel here
   /// instead of once per voxel in the integration loop (empty without interpolate_depth).
@@ -203,7 +206,8 @@ DP_INTEGRATION_STEP bool endsBetweenRays(float d_near, float d_far, float p_far,
 /// wall's continuation, and the grazing wall's last pixel, at the corner, is predicted by both
 /// planes but exactly only by its own.
 DP_INTEGRATION_STEP bool continuesSurface(const float* inv, const float* dep, std::size_t i,
-                                          std::size_t step, const PairNeighbours& has, float tol) {
+                                          std::size_t step, const PairNeighbours& has, float tol,
+                                          bool* one_side) {
   const std::size_t j = i + step;
   const float inv_a = has.a ? inv[i - step] : 0.0f;
   const float inv_b = has.b ? inv[j + step] : 0.0f;
@@ -212,6 +216,7 @@ DP_INTEGRATION_STEP bool continuesSurface(const float* inv, const float* dep, st
   const float p_i = 2.0f * inv[j] - inv_b;
   const bool from_i = (inv_a != 0.0f) & predicts(p_j, d_j, tol);
   const bool from_j = (inv_b != 0.0f) & predicts(p_i, d_i, tol);
+  *one_side = from_i != from_j;
   if (from_i == from_j) return from_i;
   // One side continues: the near side (a, i) when from_i, with j the farther pixel and (b, c)
   // its own side; else the near side is (b, j), i the farther pixel and (a, a2) its side.
@@ -290,7 +295,10 @@ DP_INTEGRATION_STEP void spreadOverNearSide(int w, int h, float jump, int radius
 /// surface seen at a grazing angle far away steps by more than mu from pixel to pixel, but
 /// continues its neighbours' plane: no rim there). near_side_only: the nearer pixel of a
 /// discontinuity (the valid one next to an invalid one) is a seed; else both valid pixels are.
-DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only, DepthFrame* f) {
+/// soft (w x h, zeroed by the caller), if given: the nearer pixel of each step that only one
+/// side continues (the second look's extra rims, grazingPlaneAllowances).
+DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only, DepthFrame* f,
+                                  std::uint8_t* soft = nullptr) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
   f->edge.assign(n, 0);
   const float* inv = f->inverse.data();
@@ -303,7 +311,14 @@ DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only,
     const float di = dep[i], dj = dep[j];
     const bool vi = inv[i] != 0.0f, vj = inv[j] != 0.0f;
     if (std::abs(dj - di) <= jump) return;  // false for NaN and +Inf: they differ
-    if (vi & vj && continuesSurface(inv, dep, i, step, has, tol)) return;
+    bool one_side = false;
+    if (vi & vj && continuesSurface(inv, dep, i, step, has, tol, &one_side)) {
+      if (soft != nullptr && one_side) {  // the nearer side, in case its surface ends there
+        soft[i] |= dj > di;
+        soft[j] |= di > dj;
+      }
+      return;
+    }
     if (near_side_only) {
       edge[i] |= vi & (!vj | (dj > di));
       edge[j] |= vj & (!vi | (di > dj));
@@ -373,6 +388,70 @@ DP_INTEGRATION_STEP void guardDepths(const PinholeCamera& cam, const RimAllowanc
       } else if (!f->cosine.empty()) {
         f->allowed[i] = grazingReach(f->cosine[i], rs);
       }
+    }
+  }
+}
+
+/// The far grazing pixels' second look, after rimAllowances. A surface seen at grazing
+/// incidence far away steps by more than mu per pixel, so its pixels get no incidence (no
+/// neighbour within mu) and reach only mu along the ray: a board's top seen a few degrees from
+/// its plane got no "inside" values a voxel under it (issue 22, defect 4). Where a pixel and its
+/// neighbours along a row or column lie on one plane, that plane gives the incidence and with it
+/// the grazing reach. But the step from such a board to the wall behind it continues the
+/// board's plane too (the wall across a concave corner reads the same), so for this look the
+/// near sides of steps one side continues (f->soft_edge) are rims as well, every rim binds
+/// (also one nearer by more than mu: on a surface seen this grazing the next pixel lies farther
+/// than that), and the rim distance rule bounds the reach. Taken only where it allows more than
+/// the first look, so no pixel reaches less deep. Few pixels need it (tens to hundreds per
+/// frame), so each is done alone: the incidence by incidenceCosine, the nearest rim by a search
+/// of the window beyond which no rim can bind (the travel there exceeds the reach).
+DP_INTEGRATION_STEP void grazingPlaneAllowances(const PinholeCamera& camera, float mu,
+                                                const RimAllowanceSettings& rs, float metres_per_px,
+                                                DepthFrame* f) {
+  constexpr int kMaxWindowRadius = 16;  // px; a pixel whose rims could bind farther keeps mu
+  const int w = camera.width, h = camera.height;
+  const float* dep = f->depth.data();
+  const float* inv = f->inverse.data();
+  const float* first = f->cosine.data();
+  const std::uint8_t* edge = f->edge.data();
+  const std::uint8_t* soft = f->soft_edge.data();
+  float* allowed = f->allowed.data();
+  const float plane_tol = 0.5f * mu;
+  RimAllowanceSettings any_rim = rs;
+  any_rim.jump = std::numeric_limits<float>::infinity();
+  const float scale = rs.rim_scale * metres_per_px;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      if (!(first[i] < 0.0f) || inv[i] == 0.0f) continue;
+      const float c = incidenceCosine(camera, dep, inv, u, v, mu, plane_tol);
+      if (!(c > 0.0f)) continue;
+      const float z = dep[i];
+      const float sine = std::sqrt(std::max(0.0f, 1.0f - c * c));
+      // No rim farther than this binds: the travel there is at least the reach.
+      const float bind_px = grazingReach(c, rs) * c * sine / (scale * z);
+      if (!(bind_px < kMaxWindowRadius)) continue;
+      const int r = static_cast<int>(std::ceil(bind_px));
+      float best = SeedDistances::kNoSeed;
+      std::size_t nearest = i;
+      for (int vv = std::max(0, v - r); vv <= std::min(h - 1, v + r); ++vv) {
+        for (int uu = std::max(0, u - r); uu <= std::min(w - 1, u + r); ++uu) {
+          const std::size_t q = static_cast<std::size_t>(vv) * w + uu;
+          const float squared = static_cast<float>((uu - u) * (uu - u) + (vv - v) * (vv - v));
+          if ((edge[q] | soft[q]) && squared < best) {
+            best = squared;
+            nearest = q;
+          }
+        }
+      }
+      float rim_c = first[nearest];
+      if (nearest != i && rim_c < 0.0f) {
+        rim_c = incidenceCosine(camera, dep, inv, static_cast<int>(nearest % w),
+                                static_cast<int>(nearest / w), mu, plane_tol);
+      }
+      const float a = rimAllowance(best, z, c, dep[nearest], rim_c, (edge[i] | soft[i]) != 0, true,
+                                   scale, any_rim);
+      allowed[i] = std::max(allowed[i], a);
     }
   }
 }
@@ -475,7 +554,9 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
     f.cosine.clear();
   }
   if (rim_rule) {
-    markRims(w, h, mu, c.edge_guard_near_side_only, &f);
+    const bool second_look = rs.reach > 0.0f;
+    if (second_look) f.soft_edge.assign(n, 0);
+    markRims(w, h, mu, c.edge_guard_near_side_only, &f, second_look ? f.soft_edge.data() : nullptr);
     // Beyond this distance from its rim no pixel is bound by it, so the transform need not look
     // farther: bound means D z / (f c s) < reach(c) = min(reach_max, max(mu, r / c)), so
     // D < f s max(mu c, r) / z <= f max(mu / 2, r) / z (c s = sin(2 theta) / 2 <= 1/2, s <= 1),
@@ -485,12 +566,14 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
     const double focal = std::max(camera.fx, camera.fy);
     const double bound = std::max(0.5 * static_cast<double>(mu), static_cast<double>(rs.reach));
     const double beyond = bound * focal / (c.edge_guard_rim_scale * f.min_depth) + 1.0;
-    seedDistances(w, h, f.edge.data(), &f.rim_distances,
-                  static_cast<float>(std::max(beyond, rs.fallback_radius_px + 1.0)),
+    const float beyond_px = static_cast<float>(std::max(beyond, rs.fallback_radius_px + 1.0));
+    seedDistances(w, h, f.edge.data(), &f.rim_distances, beyond_px,
                   {f.depth.data(), f.cosine.data()});
     f.allowed.resize(n);
+    const float metres_per_px = static_cast<float>(1.0 / focal);
     rimAllowances(f.depth.data(), f.inverse.data(), f.edge.data(), &f.rim_distances,
-                  f.cosine.data(), n, static_cast<float>(1.0 / focal), rs, f.allowed.data());
+                  f.cosine.data(), n, metres_per_px, rs, f.allowed.data());
+    if (second_look) grazingPlaneAllowances(camera, mu, rs, metres_per_px, &f);
   } else if (radius > 0 || rs.reach > 0.0f) {
     if (radius > 0) markNearEdges(w, h, mu, radius, c.edge_guard_near_side_only, &f);
     guardDepths(camera, rs, static_cast<float>(c.edge_guard_grazing_voxels), &f);

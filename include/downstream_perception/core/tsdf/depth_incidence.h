@@ -13,13 +13,17 @@ struct PinholeCamera;
 /// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
 /// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when
 /// either direction has no such neighbour (a far grazing surface stepping by more than jump per
-/// pixel) or the surface is degenerate. depth: m (NaN where not
-/// valid); inverse: 1 / depth, 0 where not a valid depth.
+/// pixel) or the surface is degenerate. plane_tol > 0 (m): along a row or column where the
+/// pixel and both its neighbours lie on one plane (inverse depth affine: the two predict the
+/// third within plane_tol), a neighbour beyond `jump` counts too (such a far grazing surface
+/// gets an estimate). depth: m (NaN where not valid); inverse: 1 / depth, 0 where not a valid
+/// depth.
 float incidenceCosine(const PinholeCamera& camera, const float* depth, const float* inverse, int u,
-                      int v, float jump);
+                      int v, float jump, float plane_tol = 0.0f);
 
-/// incidenceCosine for every pixel of the image, into `cosine` (w * h): the interior rows
-/// branch-free (vectorised), the border pixels one at a time. column_x: scratch, reused.
+/// incidenceCosine (no plane tolerance) for every pixel of the image, into `cosine` (w * h): the
+/// interior rows branch-free (vectorised), the border pixels one at a time. column_x: scratch,
+/// reused.
 void incidenceCosines(const PinholeCamera& camera, const float* depth, const float* inverse,
                       float jump, std::vector<float>* column_x, float* cosine);
 /// The interior pixels of incidenceCosines (not the image's first and last rows and columns);
