@@ -13,18 +13,6 @@
 
 namespace downstream_perception {
 
-namespace {
-
-/// Whether three valid pixels along an image line (inverse depths a, b, c; c's depth d_c) lie on
-/// one plane: inverse depth is affine along the line, so 2 b - a predicts c within `tol` (m).
-[[gnu::always_inline]] inline bool onePlane(float a, float b, float c, float d_c, float tol) {
-  const float predicted = 2.0f * b - a;
-  return (a != 0.0f) & (b != 0.0f) & (c != 0.0f) & (predicted > 0.0f) &
-         (std::abs(d_c * predicted - 1.0f) <= tol * predicted);
-}
-
-}  // namespace
-
 float incidenceCosine(const PinholeCamera& camera, const float* depth, const float* inverse, int u,
                       int v, float jump, float plane_tol) {
   const int w = camera.width, h = camera.height;
@@ -48,8 +36,9 @@ float incidenceCosine(const PinholeCamera& camera, const float* depth, const flo
     if (u0 >= 0 && v0 >= 0 && u1 < w && v1 < h) {
       const std::size_t j0 = static_cast<std::size_t>(v0) * w + u0;
       const std::size_t j1 = static_cast<std::size_t>(v1) * w + u1;
-      if (plane_tol > 0.0f &&
-          onePlane(inverse[j0], inverse[i], inverse[j1], depth[j1], plane_tol)) {
+      // Inverse depth is affine along an image line on a plane: 2 / d - 1 / d0 predicts 1 / d1.
+      if (plane_tol > 0.0f && inverse[j0] != 0.0f && inverse[j1] != 0.0f &&
+          predictsDepth(2.0f * inverse[i] - inverse[j0], depth[j1], plane_tol)) {
         best = std::numeric_limits<float>::infinity();
       }
     }

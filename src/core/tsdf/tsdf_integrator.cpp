@@ -170,11 +170,6 @@ struct PairNeighbours {
   bool a, b, a2, c;
 };
 
-/// Whether 1 / d predicted by an inverse depth `predicted` (> 0) lies within `tol` (m) of d.
-DP_INTEGRATION_STEP bool predicts(float predicted, float d, float tol) {
-  return (predicted > 0.0f) & (std::abs(d * predicted - 1.0f) <= tol * predicted);
-}
-
 /// continuesSurface's occluding-edge test, for a near pixel (depth d_near) whose side's plane
 /// predicts the inverse depth p_far for the farther pixel (depth d_far) across the step: the
 /// farther pixel lies beyond that continuation, and the plane of its own side (its next two
@@ -214,8 +209,8 @@ DP_INTEGRATION_STEP bool continuesSurface(const float* inv, const float* dep, st
   const float d_i = dep[i], d_j = dep[j];
   const float p_j = 2.0f * inv[i] - inv_a;
   const float p_i = 2.0f * inv[j] - inv_b;
-  const bool from_i = (inv_a != 0.0f) & predicts(p_j, d_j, tol);
-  const bool from_j = (inv_b != 0.0f) & predicts(p_i, d_i, tol);
+  const bool from_i = (inv_a != 0.0f) & predictsDepth(p_j, d_j, tol);
+  const bool from_j = (inv_b != 0.0f) & predictsDepth(p_i, d_i, tol);
   *one_side = from_i != from_j;
   if (from_i == from_j) return from_i;
   // One side continues: the near side (a, i) when from_i, with j the farther pixel and (b, c)
@@ -340,6 +335,9 @@ DP_INTEGRATION_STEP void markRims(int w, int h, float jump, bool near_side_only,
   }
 }
 
+/// kFixedRadius: the guard's mask f->near_edge. The rims (markRims) spread by `radius` pixels:
+/// near_side_only, only over pixels not more than `jump` farther (spreadOverNearSide); else to
+/// every pixel within `radius` (the guard before issue 22's defect 4).
 DP_INTEGRATION_STEP void markNearEdges(int w, int h, float jump, int radius, bool near_side_only,
                                        DepthFrame* f) {
   const std::size_t n = static_cast<std::size_t>(w) * h;

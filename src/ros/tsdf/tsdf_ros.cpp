@@ -47,8 +47,7 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   const TsdfNodeSettings settings = readTsdfNodeSettings(pnh_, &config_errors_);
   health_period_s_ = settings.health_period_s;
   // Images early for their CameraInfo wait as many as wait for tf.
-  tf_queue_size_ = static_cast<std::size_t>(settings.tf_queue_size);
-  camera_infos_ = CameraInfoCache(tf_queue_size_);
+  camera_infos_ = CameraInfoCache(static_cast<std::size_t>(settings.tf_queue_size));
   slice_ = settings.slice;
   slice_distance_max_m_ = settings.slice_distance_max_m;
   slice_window_ = settings.slice_window;
@@ -282,7 +281,7 @@ void TsdfRos::onDepthRaw(const sensor_msgs::ImageConstPtr& msg) {
   if (dropped != nullptr) {
     rejected_.reject("camera_info missing or inconsistent",
                      "no CameraInfo for frame '" + dropped->header.frame_id + "' while " +
-                         std::to_string(tf_queue_size_) + " images waited for one");
+                         std::to_string(camera_infos_.maxWaiting()) + " images waited for one");
     return;
   }
   acceptDepth(msg);

@@ -3,12 +3,19 @@
 // voxels read it.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
 namespace downstream_perception {
 
 struct PinholeCamera;
+
+/// Whether the inverse depth `predicted` (> 0; from the plane of neighbouring pixels) lies
+/// within `tol` (m) of the depth d: |d - 1 / predicted| <= tol.
+[[gnu::always_inline]] inline bool predictsDepth(float predicted, float d, float tol) {
+  return (predicted > 0.0f) & (std::abs(d * predicted - 1.0f) <= tol * predicted);
+}
 
 /// |cos| of the angle between pixel (u, v)'s ray and the surface normal, estimated from the
 /// neighbours (along the row and along the column) nearest in depth within `jump` (m); -1 when

@@ -35,6 +35,7 @@ class CameraInfoCache {
   sensor_msgs::ImageConstPtr wait(const sensor_msgs::ImageConstPtr& image);
 
   std::size_t waiting() const { return waiting_.size(); }
+  std::size_t maxWaiting() const { return max_waiting_; }
 
  private:
   std::size_t max_waiting_;

@@ -104,7 +104,6 @@ class TsdfRos {
   TsdfMesher mesher_;
   TsdfMeshMarkers markers_;
   CameraInfoCache camera_infos_{0};  ///< latest per frame id; images early for theirs wait
-  std::size_t tf_queue_size_ = 10;   ///< ~tf_queue_size
 
   std::shared_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
