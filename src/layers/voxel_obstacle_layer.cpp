@@ -241,6 +241,8 @@ void VoxelObstacleLayer::onClockJump() {
     s->legacy_cloud_sub.clearWaiting();
     s->depth_sub.clearWaiting();
     s->scan_sub.clearWaiting();
+    std::lock_guard<std::mutex> lock(mutex_);
+    s->waiting_for_camera.clear();  // stamped before the jump
   }
 }
 
@@ -378,6 +380,10 @@ void VoxelObstacleLayer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
     if (s->scan)
       status.add(p + "per-beam correction skipped (no tf at the last beam)", s->deskew_skipped);
     if (!s->last_rejection.empty()) status.add(p + "last refusal", s->last_rejection);
+    if (s->depth) {
+      status.add(p + "depth images waiting for their first CameraInfo",
+                 s->waiting_for_camera.size());
+    }
     status.add(p + "last rays", s->last.rays);
     status.add(p + "last voxels marked", s->last.marked);
     status.add(p + "last voxels cleared", s->last.cleared);

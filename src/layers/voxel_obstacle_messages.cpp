@@ -6,6 +6,7 @@
 #include <sensor_msgs/point_cloud_conversion.h>
 
 #include <chrono>
+#include <deque>
 #include <functional>
 
 #include "downstream_perception/core/voxel/depth_rays.h"
@@ -68,25 +69,50 @@ void VoxelObstacleLayer::onCameraInfo(Source* s, const sensor_msgs::CameraInfoCo
     reject(s, "camera_info: " + why);
     return;
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  s->camera = cam;
+  std::deque<sensor_msgs::ImageConstPtr> waited;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s->camera = cam;
+    waited.swap(s->waiting_for_camera);
+  }
+  for (const auto& image : waited) integrateDepth(s, image, cam);
 }
 
 void VoxelObstacleLayer::onDepth(Source* s, const sensor_msgs::ImageConstPtr& msg) {
+  std::string why;
+  const bool well_formed = checkDepthImage(*msg, &why);  // before it may be held
   std::optional<PinholeCamera> cam;
+  sensor_msgs::ImageConstPtr pushed_out;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++s->received;
     cam = s->camera;
+    if (!cam && well_formed) {
+      // The image overtook its first CameraInfo (two topics on two connections: nothing orders
+      // them at start-up or in a bag replay). It waits, at most tf_queue_size of them.
+      s->waiting_for_camera.push_back(msg);
+      if (s->waiting_for_camera.size() > static_cast<std::size_t>(s->tf_queue_size)) {
+        pushed_out = s->waiting_for_camera.front();
+        s->waiting_for_camera.pop_front();
+      }
+    }
   }
-  if (!cam) {
-    reject(s, "no camera_info yet on " + s->camera_info_topic);
-    return;
+  if (!well_formed) {
+    reject(s, "depth image: " + why);
+  } else if (cam) {
+    integrateDepth(s, msg, *cam);
+  } else if (pushed_out) {
+    reject(s, "no camera_info on " + s->camera_info_topic + " while " +
+                  std::to_string(s->tf_queue_size) + " depth images waited for one");
   }
-  if (static_cast<int>(msg->width) != cam->width || static_cast<int>(msg->height) != cam->height) {
+}
+
+void VoxelObstacleLayer::integrateDepth(Source* s, const sensor_msgs::ImageConstPtr& msg,
+                                        const PinholeCamera& cam) {
+  if (static_cast<int>(msg->width) != cam.width || static_cast<int>(msg->height) != cam.height) {
     reject(s, "image " + std::to_string(msg->width) + " x " + std::to_string(msg->height) +
-                  " does not match camera_info's " + std::to_string(cam->width) + " x " +
-                  std::to_string(cam->height));
+                  " does not match camera_info's " + std::to_string(cam.width) + " x " +
+                  std::to_string(cam.height));
     return;
   }
   std::vector<float> metres;
@@ -101,11 +127,11 @@ void VoxelObstacleLayer::onDepth(Source* s, const sensor_msgs::ImageConstPtr& ms
     return;
   }
   if (s->frustum) {
-    integrateFrustum(s, metres, *cam, pose, msg->header.stamp);
+    integrateFrustum(s, metres, cam, pose, msg->header.stamp);
     return;
   }
   DepthRays rays;
-  depthToRays(metres.data(), *cam, pose, s->zero_is_no_return, s->stride, &rays);
+  depthToRays(metres.data(), cam, pose, s->zero_is_no_return, s->stride, &rays);
   integrate(s, pose.translation(), rays.hits, rays.no_returns, msg->header.stamp);
 }
 

@@ -201,6 +201,7 @@ void VoxelObstacleLayer::deactivate() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       s->subscribed_since = ros::WallTime();
+      s->waiting_for_camera.clear();
     }
     s->cloud_sub.unsubscribe();
     s->legacy_cloud_sub.unsubscribe();

@@ -83,6 +83,8 @@ class VoxelObstacleLayer : public Layer {
     ros::Subscriber info_sub;
     // Guarded by the layer's mutex_.
     std::optional<PinholeCamera> camera;
+    /// Depth images that came before the first CameraInfo (oldest first, <= tf_queue_size).
+    std::deque<sensor_msgs::ImageConstPtr> waiting_for_camera;
     std::size_t received = 0;
     std::size_t integrated = 0;
     std::size_t rejected = 0;
@@ -101,6 +103,9 @@ class VoxelObstacleLayer : public Layer {
   void onLegacyCloud(Source* s, const sensor_msgs::PointCloudConstPtr& msg);
   void onCloudMessage(Source* s, const sensor_msgs::PointCloud2& msg);
   void onDepth(Source* s, const sensor_msgs::ImageConstPtr& msg);
+  /// A depth image with the camera it is read with (checked against the image's size).
+  void integrateDepth(Source* s, const sensor_msgs::ImageConstPtr& msg,
+                      const PinholeCamera& camera);
   void onScan(Source* s, const sensor_msgs::LaserScanConstPtr& msg);
   void onCameraInfo(Source* s, const sensor_msgs::CameraInfoConstPtr& msg);
   void reject(Source* s, const std::string& why);

@@ -16,7 +16,7 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs import point_cloud2
-from sensor_msgs.msg import PointCloud2
+from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Bool
 from tf2_ros import StaticTransformBroadcaster
 
@@ -30,7 +30,14 @@ class VoxelLayerTest(unittest.TestCase):
     def setUpClass(cls) -> None:
         rospy.init_node("test_voxel_layer")
         cls.static_tf = StaticTransformBroadcaster()
-        cls.static_tf.sendTransform(transform_stamped("odom", "base_link", rospy.Time.now(), y=1.5))
+        now = rospy.Time.now()
+        # late_camera: outside the simulated room, looking up (optical z = odom z).
+        cls.static_tf.sendTransform(
+            [
+                transform_stamped("odom", "base_link", now, y=1.5),
+                transform_stamped("odom", "late_camera", now, x=2.5, y=2.5, z=1.0),
+            ]
+        )
         cls.done = False
         cls.voxels: np.ndarray | None = None
 
@@ -43,11 +50,13 @@ class VoxelLayerTest(unittest.TestCase):
 
         cls.lock = threading.Lock()
         cls.warnings: list[str] = []
+        cls.values: dict[str, str] = {}
 
         def on_diagnostics(msg: DiagnosticArray) -> None:
             with cls.lock:
                 for status in msg.status:
                     cls.warnings += [kv.value for kv in status.values if "warning" in kv.key]
+                    cls.values.update({kv.key: kv.value for kv in status.values})
 
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=20)
         rospy.Subscriber("/depth_sim/done", Bool, on_done, queue_size=1)
@@ -77,6 +86,48 @@ class VoxelLayerTest(unittest.TestCase):
         # The open floor between the objects: not lethal.
         self.assertNotEqual(self.costmap.cell(0.0, 1.3), 100)
         self.assertNotEqual(self.costmap.cell(-1.0, -1.5), 100)
+
+    def value(self, key: str) -> str | None:
+        with self.lock:
+            return self.values.get(key)
+
+    def test_an_image_before_its_first_camera_info_waits_for_it(self) -> None:
+        # voxel_layer.test's second depth source: its first image comes before its CameraInfo
+        # (the two topics are not ordered against each other); it waits and is integrated then.
+        if not rospy.has_param("/costmap/voxels/late"):
+            self.skipTest("this launch has no 'late' source")
+        image_pub = rospy.Publisher("/late_camera/depth", Image, queue_size=1)
+        info_pub = rospy.Publisher("/late_camera/camera_info", CameraInfo, queue_size=1)
+        self.assertTrue(wait_until(lambda: image_pub.get_num_connections() > 0, 20.0))
+        self.assertTrue(wait_until(lambda: info_pub.get_num_connections() > 0, 20.0))
+        waiting = "source 'late' depth images waiting for their first CameraInfo"
+        integrated = "source 'late' integrated"
+        self.assertTrue(wait_until(lambda: self.value(waiting) == "0", 20.0), self.value(waiting))
+        side = 8
+        image = Image()
+        image.header.stamp = rospy.Time.now()
+        image.header.frame_id = "late_camera"
+        image.height = image.width = side
+        image.encoding = "32FC1"
+        image.is_bigendian = 0
+        image.step = 4 * side
+        image.data = np.full((side, side), 0.5, dtype="<f4").tobytes()  # 0.5 m: z = 1.5 m
+        image_pub.publish(image)
+        self.assertTrue(wait_until(lambda: self.value(waiting) == "1", 20.0), self.value(waiting))
+        self.assertEqual(self.value(integrated), "0")
+        self.assertTrue(wait_until(lambda: self.costmap.received, 10.0), "no costmap")
+        self.assertNotEqual(self.costmap.cell(2.5, 2.5), 100)
+        info = CameraInfo()
+        info.header = image.header
+        info.width = info.height = side
+        info.K = [8.0, 0.0, 3.5, 0.0, 8.0, 3.5, 0.0, 0.0, 1.0]
+        info_pub.publish(info)
+        self.assertTrue(
+            wait_until(lambda: self.value(integrated) == "1", 20.0), self.value(integrated)
+        )
+        self.assertEqual(self.value(waiting), "0")
+        # The image was integrated at its own stamp: the column above the camera is lethal.
+        self.assertTrue(wait_until(lambda: self.costmap.cell(2.5, 2.5) == 100, 10.0))
 
     def test_stvl_keys_outside_an_stvl_configuration_are_unknown(self) -> None:
         # The layer's type is ours, not STVL's: STVL's keys are not adopted, so they are warned
