@@ -28,6 +28,7 @@ half-size 320x240 camera (same field of view), 5 cm, 2 scenes, 2 offsets, 8 fram
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -108,10 +109,24 @@ def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD, dropoff: bool | None = 
 
 
 def open3d_legacy(
-    depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any, voxel_m: float
+    depths: Sequence[np.ndarray],
+    poses: Sequence[np.ndarray],
+    cam: Any,
+    voxel_m: float,
+    native_lattice: bool = False,
 ) -> Mesh:
-    """ScalableTSDFVolume without colour (0 = invalid depth)."""
+    """ScalableTSDFVolume without colour (0 = invalid depth); on our lattice unless
+    native_lattice."""
     import open3d as o3d
+
+    # Legacy's voxel centres are at (i + 1/2) v, ours and the tensor backend's at i v. Integrating
+    # in a world moved by v/2 (and moving the mesh back) puts legacy's centres where ours are, so
+    # a case compares the integrators on one lattice: else offset f here is legacy at f + 1/2,
+    # and a case's gap is mostly the lattice's (a board top half a voxel above a plane of centres
+    # meshes better than one half a voxel below, in every integrator).
+    shift_m = 0.0 if native_lattice else 0.5 * voxel_m
+    moved = np.eye(4)
+    moved[:3, 3] = shift_m
 
     intrinsic = o3d.camera.PinholeCameraIntrinsic(
         cam.width, cam.height, cam.fx, cam.fy, cam.cx, cam.cy
@@ -130,9 +145,9 @@ def open3d_legacy(
             depth_trunc=10.0,
             convert_rgb_to_intensity=False,
         )
-        volume.integrate(frame, intrinsic, np.linalg.inv(pose))
+        volume.integrate(frame, intrinsic, np.linalg.inv(moved @ pose))
     mesh = volume.extract_triangle_mesh()
-    return np.asarray(mesh.vertices), np.asarray(mesh.triangles)
+    return np.asarray(mesh.vertices) - shift_m, np.asarray(mesh.triangles)
 
 
 def open3d_tensor(
@@ -170,10 +185,14 @@ def open3d_tensor(
 
 
 def integrators(
-    edge_guards: Sequence[float], dropoffs: Sequence[bool | None] = (None,), open3d: bool = True
+    edge_guards: Sequence[float],
+    dropoffs: Sequence[bool | None] = (None,),
+    open3d: bool = True,
+    legacy_native_lattice: bool = False,
 ) -> dict[str, Integrator]:
     """Ours at each edge guard and behind_surface_dropoff setting (None: the default; the
-    defaults' one named plainly), then Open3D's when it imports (and `open3d`)."""
+    defaults' one named plainly), then Open3D's when it imports (and `open3d`); legacy on our
+    lattice unless legacy_native_lattice."""
     found: dict[str, Integrator] = {}
     for rad in edge_guards:
         for dropoff in dropoffs:
@@ -187,7 +206,7 @@ def integrators(
         import open3d  # noqa: F401
     except ImportError:
         return found
-    found["Open3D legacy"] = open3d_legacy
+    found["Open3D legacy"] = functools.partial(open3d_legacy, native_lattice=legacy_native_lattice)
     found["Open3D tensor"] = open3d_tensor
     return found
 
@@ -247,12 +266,13 @@ def run(
     log: Callable[[str], None] = print,
     dropoffs: Sequence[bool | None] = (None,),
     open3d: bool = True,
+    legacy_native_lattice: bool = False,
 ) -> list[Score]:
     from downstream_perception.sim.depth_camera import DepthCamera
     from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
     from downstream_perception.tsdf_eval import observed_samples
 
-    chosen = integrators(edge_guards, dropoffs, open3d)
+    chosen = integrators(edge_guards, dropoffs, open3d, legacy_native_lattice)
     cameras = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
@@ -444,6 +464,12 @@ def main() -> None:
         help="comma-separated behind_surface_dropoff settings for ours: default, on, off",
     )
     parser.add_argument("--no-open3d", action="store_true", help="ours only")
+    parser.add_argument(
+        "--legacy-lattice",
+        choices=("ours", "native"),
+        default="ours",
+        help="Open3D legacy's voxel centres: on ours (i v; default) or its own ((i + 1/2) v)",
+    )
     parser.add_argument("--json", type=Path, help="write every score here")
     args = parser.parse_args()
     scenes = [s for s in args.scenes.split(",") if s]
@@ -475,6 +501,7 @@ def main() -> None:
         scale,
         dropoffs=dropoffs,
         open3d=not args.no_open3d,
+        legacy_native_lattice=args.legacy_lattice == "native",
     )
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

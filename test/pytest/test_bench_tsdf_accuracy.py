@@ -129,3 +129,52 @@ def test_near_mesh_matches_sampling_every_triangle(bench: Any, room: tuple) -> N
     distance, _ = cKDTree(surface).query(observed, distance_upper_bound=0.02)
     np.testing.assert_array_equal(near, np.isfinite(distance))
     assert 0.3 < near.mean() < 0.99  # both kinds of answer occur
+
+
+def test_open3d_legacy_runs_on_our_lattice(bench: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Open3D legacy puts its voxel centres at (i + 1/2) v, ours at i v: the bench integrates it in
+    # a world moved by v/2 and moves its mesh back. Open3D is not installed here, so a stand-in
+    # module records what legacy would be given.
+    import types
+
+    extrinsics: list[np.ndarray] = []
+
+    class Volume:
+        def __init__(self, **kwargs: Any) -> None:
+            self.voxel = kwargs["voxel_length"]
+
+        def integrate(self, frame: Any, intrinsic: Any, extrinsic: np.ndarray) -> None:
+            extrinsics.append(np.asarray(extrinsic))
+
+        def extract_triangle_mesh(self) -> Any:
+            # A vertex on legacy's voxel centre (0 + 1/2) v in its moved world.
+            v = 0.5 * self.voxel
+            return types.SimpleNamespace(vertices=[[v, v, v]], triangles=[[0, 0, 0]])
+
+    o3d = types.SimpleNamespace(
+        camera=types.SimpleNamespace(PinholeCameraIntrinsic=lambda *a: a),
+        geometry=types.SimpleNamespace(
+            Image=lambda a: a,
+            RGBDImage=types.SimpleNamespace(create_from_color_and_depth=lambda *a, **k: a),
+        ),
+        pipelines=types.SimpleNamespace(
+            integration=types.SimpleNamespace(
+                ScalableTSDFVolume=Volume,
+                TSDFVolumeColorType=types.SimpleNamespace(NoColor=0),
+            )
+        ),
+    )
+    monkeypatch.setitem(sys.modules, "open3d", o3d)
+    cam = types.SimpleNamespace(width=4, height=3, fx=2.0, fy=2.0, cx=1.5, cy=1.0)
+    pose = np.eye(4)
+    pose[:3, 3] = (1.0, 2.0, 3.0)
+    depth = np.ones((3, 4), np.float32)
+    vertices, _ = bench.open3d_legacy([depth], [pose], cam, 0.02)
+    np.testing.assert_allclose(vertices, [[0.0, 0.0, 0.0]], atol=1e-12)  # on our centre 0
+    # The camera seen from the moved world: a point at x in ours is at x + v/2 in legacy's.
+    point = np.array([0.3, -0.2, 0.7, 1.0])
+    moved = point + np.array([0.01, 0.01, 0.01, 0.0])
+    np.testing.assert_allclose(extrinsics[0] @ moved, np.linalg.inv(pose) @ point, atol=1e-12)
+    native, _ = bench.open3d_legacy([depth], [pose], cam, 0.02, native_lattice=True)
+    np.testing.assert_allclose(native, [[0.01, 0.01, 0.01]], atol=1e-12)
+    np.testing.assert_allclose(extrinsics[1], np.linalg.inv(pose), atol=1e-12)
