@@ -860,7 +860,14 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
                                              b * ((1.0f - a) * i01[x] + a * i11[x]));
           const float d = (flags[x] & 1) ? interpolated : nearest[x];
           // sdf = (depth - z) * |ray| / z, with |ray| / z from the pixel's table.
-          const float sdf = in_band ? (d - z_axis) * range[x] : muf;
+          // Where a pixel's reach behind its surface is cut below mu (next to a rim) its band is
+          // cut alike in front: a value beyond the allowance counts as the allowance, as values
+          // beyond mu count as mu. Cut on one side only, the band kept the front half of a
+          // zero-mean spread (pixel steps at grazing incidence, depth noise) and pushed the voxels
+          // at the surface positive: a surface on a plane of voxel centres lost its crossings
+          // next to its rims (issue 22, defect 4). Elsewhere (allowance >= mu) this changes
+          // nothing, and the tests below only look at values behind the surface.
+          const float sdf = in_band ? std::min((d - z_axis) * range[x], allowed[x]) : muf;
           const bool update =
               (along_axis >= -allowed[x] - max_step) &
               !(no_return & (z_axis > max_z)) &  // no return: free only up to max_depth_m

@@ -509,7 +509,9 @@ TEST(DepthRims, AShelfTopAtGrazingIncidenceOnVoxelCentresIsMeshed) {
   const double covered_before = shelfTopCovered(before, &ghosts_before);
   std::printf("shelf top covered %.3f (before %.3f); ghosts %zu (before %zu)\n", covered,
               covered_before, ghosts, ghosts_before);
-  EXPECT_GT(covered, 0.7);
+  // 0.79 while the band next to the shelf's rims was cut behind the surface only (its voxels,
+  // on the top's plane, then fused positive); 0.87 with the band cut alike in front.
+  EXPECT_GT(covered, 0.84);
   EXPECT_GT(covered, covered_before + 0.3);
   EXPECT_LE(ghosts, ghosts_before);
 }
