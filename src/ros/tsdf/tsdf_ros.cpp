@@ -102,6 +102,9 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   cloud_subscriber_ = nh_.subscribe("points", 5, &TsdfRos::onCloudRaw, this);
   mesh_timer_ =
       pnh_.createTimer(ros::Duration(1.0 / settings.mesh_rate_hz), &TsdfRos::publishMesh, this);
+  // On the steady clock: a jump of the ROS clock must not hold up its own detection.
+  clock_watch_ =
+      nh_.createSteadyTimer(ros::WallDuration(kClockWatchPeriodS), &TsdfRos::watchClock, this);
   reconfigure_.start(pnh_, this, &TsdfRos::reconfigure);
   const TsdfConfig& c = map_->config();
   ROS_INFO(
@@ -114,12 +117,30 @@ TsdfRos::TsdfRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 TsdfRos::~TsdfRos() {
+  clock_watch_.stop();
   reconfigure_.stop();
   mesh_timer_.stop();
   depth_subscriber_.shutdown();
   cloud_subscriber_.shutdown();
   depth_filter_.unsubscribe();
   cloud_filter_.unsubscribe();
+}
+
+void TsdfRos::watchClock(const ros::SteadyTimerEvent&) {
+  if (clock_jump_.check(ros::Time::now(), "tsdf") == 0.0) return;
+  // A looped bag or a restarted simulator: the messages waiting for tf wait for old-timeline
+  // stamps, tf restarts as in the other components (clock_jump.h), and the health check and
+  // the diagnostics updater would wait until the clock passed their old-timeline times. The
+  // map itself does not age.
+  depth_filter_.clearWaiting();
+  cloud_filter_.clearWaiting();
+  restartTf(*tf_buffer_, tf_listener_, nh_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    camera_infos_.clearWaiting();
+    last_health_ = ros::Time();  // the health check's period restarts on the new timeline
+  }
+  diagnostics_.force_update();  // the updater, too, waits for its next (old-timeline) time
 }
 
 void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {

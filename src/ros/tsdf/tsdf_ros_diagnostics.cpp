@@ -36,6 +36,7 @@ void TsdfRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("frames integrated", frames_integrated_);
   status.add("frames rejected", rejected);
   status.add("depth images waiting for their first CameraInfo", camera_infos_.waiting());
+  status.add("clock jumps back (waiting messages and tf reset)", clock_jump_.jumps());
   status.add("integration time mean (ms)", integrate_ms_.mean());
   status.add("integration time max (ms)", integrate_ms_.max);
   addTimingHistogram(status, "integration time", "ms", integrate_ms_.histogram);

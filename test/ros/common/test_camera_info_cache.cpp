@@ -70,5 +70,15 @@ TEST(CameraInfoCache, WithNoRoomAnImageIsReturnedAtOnce) {
   EXPECT_EQ(cache.waiting(), 0u);
 }
 
+TEST(CameraInfoCache, AClockJumpDropsTheWaitingImagesButKeepsTheCameraInfos) {
+  CameraInfoCache cache(4);
+  cache.update(info("a", 320));
+  EXPECT_EQ(cache.wait(image("b", 1)), nullptr);
+  cache.clearWaiting();
+  EXPECT_EQ(cache.waiting(), 0u);
+  EXPECT_TRUE(cache.update(info("b", 160)).empty());  // nothing of the old timeline comes out
+  EXPECT_EQ(cache.find("a")->width, 320u);
+}
+
 }  // namespace
 }  // namespace downstream_perception

@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""rostest: on simulated time, /clock jumps back 30 s. The costmap and the tracker must notice
-(diagnostics count it), and keep publishing at the new timeline's stamps within seconds, instead
-of waiting until the clock passes its old maximum."""
+"""rostest: on simulated time, /clock jumps back 30 s. The costmap, the tracker and the TSDF must
+notice (diagnostics count it), and keep publishing (integrating) at the new timeline's stamps
+within seconds, instead of waiting until the clock passes its old maximum. The static transforms
+are sent once, before the jump (nothing sends them again after it)."""
 
 from __future__ import annotations
 
 import math
+import struct
 import threading
 import time
 import unittest
@@ -16,7 +18,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from map_msgs.msg import OccupancyGridUpdate
 from nav_msgs.msg import OccupancyGrid
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import CameraInfo, Image, LaserScan
 from tf2_ros import StaticTransformBroadcaster, TransformBroadcaster
 
 from downstream_perception.msg import DetectedObject, DetectedObjectArray, TrackedObjectArray
@@ -89,9 +91,14 @@ class ClockJumpTest(unittest.TestCase):
         cls.costmap = CostmapClient("/costmap/costmap")
         cls.scan_pub = rospy.Publisher("/cj/scan", LaserScan, queue_size=10)
         cls.detection_pub = rospy.Publisher("/cj/detections", DetectedObjectArray, queue_size=10)
+        cls.depth_pub = rospy.Publisher("/cj/depth/image", Image, queue_size=10)
+        cls.info_pub = rospy.Publisher("/cj/depth/camera_info", CameraInfo, queue_size=10)
         cls.static_tf = StaticTransformBroadcaster()
         cls.static_tf.sendTransform(
-            transform_stamped("base_link", "laser", cls.clock.now(), x=0.05, y=0.05)
+            [
+                transform_stamped("base_link", "laser", cls.clock.now(), x=0.05, y=0.05),
+                transform_stamped("base_link", "camera", cls.clock.now(), z=0.5),
+            ]
         )
         cls.tf = TransformBroadcaster()
         cls.beam = 0  # the scan's one obstacle: beam 0 (+x) before the jump, beam 2 (+y) after
@@ -117,8 +124,22 @@ class ClockJumpTest(unittest.TestCase):
                 msg = DetectedObjectArray(detections=[d])
                 msg.header.stamp, msg.header.frame_id = stamp, "laser"
                 cls.detection_pub.publish(msg)
+                cls.publish_depth(stamp)
             tick += 1
             time.sleep(0.05)
+
+    @classmethod
+    def publish_depth(cls, stamp: rospy.Time) -> None:
+        """A 16 x 12 depth image of a plane 1 m ahead (the camera looks up), and its CameraInfo."""
+        width, height = 16, 12
+        info = CameraInfo(width=width, height=height)
+        info.header.stamp, info.header.frame_id = stamp, "camera"
+        info.K = [10.0, 0.0, 7.5, 0.0, 10.0, 5.5, 0.0, 0.0, 1.0]
+        cls.info_pub.publish(info)
+        image = Image(height=height, width=width, encoding="32FC1", is_bigendian=0, step=4 * width)
+        image.header = info.header
+        image.data = struct.pack(f"<{width * height}f", *([1.0] * (width * height)))
+        cls.depth_pub.publish(image)
 
     def newest(self, key: str) -> float:
         with self.lock:
@@ -137,16 +158,16 @@ class ClockJumpTest(unittest.TestCase):
                             return int(kv.value)
         return -1
 
-    def test_costmap_and_tracker_keep_publishing_after_the_clock_jumps_back(self) -> None:
+    def test_costmap_tracker_and_tsdf_keep_working_after_the_clock_jumps_back(self) -> None:
         self.assertTrue(wait_until(lambda: self.newest("costmap") > START_S, 20.0), "no costmap")
         self.assertTrue(wait_until(lambda: self.newest("tracks") > START_S, 20.0), "no tracks")
         self.assertTrue(wait_until(lambda: self.costmap.cell(1.05, 0.05) == 100, 10.0))
+        integrated = "frames integrated"
+        self.assertTrue(wait_until(lambda: self.diagnostic("tsdf", integrated) > 0, 20.0))
         before = self.clock.now().to_sec()
         self.clock.jump(JUMP_S)
         time.sleep(0.5)
-        self.static_tf.sendTransform(
-            transform_stamped("base_link", "laser", self.clock.now(), x=0.05, y=0.05)
-        )
+        integrated_at_jump = self.diagnostic("tsdf", integrated)
         type(self).beam = 2  # something new to draw after the jump
         after = lambda key: self.newest(key) < before - JUMP_S / 2  # noqa: E731
         self.assertTrue(
@@ -164,6 +185,14 @@ class ClockJumpTest(unittest.TestCase):
         self.assertGreaterEqual(
             self.diagnostic("tracker: tracker", "clock jumps back (tracks reset)"), 1
         )
+        # The TSDF integrates the new timeline's frames (their camera mount is a static
+        # transform, sent before the jump only).
+        self.assertTrue(
+            wait_until(lambda: self.diagnostic("tsdf", integrated) >= integrated_at_jump + 5, 10.0),
+            f"the TSDF stalled after the jump: {self.status.get(self.key('tsdf'))}",
+        )
+        jumps = "clock jumps back (waiting messages and tf reset)"
+        self.assertTrue(wait_until(lambda: self.diagnostic("tsdf", jumps) >= 1, 10.0))
 
 
 if __name__ == "__main__":

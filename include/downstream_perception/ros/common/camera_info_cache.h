@@ -34,6 +34,8 @@ class CameraInfoCache {
   /// null.
   sensor_msgs::ImageConstPtr wait(const sensor_msgs::ImageConstPtr& image);
 
+  /// Drops the waiting images (a clock jump: they belong to the old timeline).
+  void clearWaiting() { waiting_.clear(); }
   std::size_t waiting() const { return waiting_.size(); }
   std::size_t maxWaiting() const { return max_waiting_; }
 

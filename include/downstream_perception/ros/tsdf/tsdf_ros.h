@@ -38,6 +38,7 @@
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 #include "downstream_perception/core/tsdf/tsdf_slice.h"
 #include "downstream_perception/ros/common/camera_info_cache.h"
+#include "downstream_perception/ros/common/clock_jump.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
 #include "downstream_perception/ros/common/reconfigure_host.h"
@@ -70,6 +71,9 @@ class TsdfRos {
                       const std::string& what, int queue);
   bool lookup(const std_msgs::Header& header, Eigen::Isometry3d* T_world_sensor, std::string* why);
   void publishMesh(const ros::TimerEvent& event);
+  /// On the steady clock: after a jump of the ROS clock back, drops the messages waiting for
+  /// old-timeline transforms and restarts tf (clock_jump.h).
+  void watchClock(const ros::SteadyTimerEvent& event);
   /// Under mutex_: the slice and, while someone listens, its clearance (the band's ESDF), over
   /// sliceGridLocked(); leaves both null and counts slices_refused_ when no grid can be made.
   void sliceLocked(const std_msgs::Header& header, nav_msgs::OccupancyGridPtr* slice,
@@ -137,6 +141,8 @@ class TsdfRos {
       defaultOutputDirectory()};  ///< ~output_dir: services write here
   ros::ServiceServer clear_service_;
   ros::Timer mesh_timer_;
+  ClockJumpDetector clock_jump_;
+  ros::SteadyTimer clock_watch_;
   diagnostic_updater::Updater diagnostics_;
 
   // Diagnostics.
