@@ -48,9 +48,9 @@ class ClockJumpDetector {
 };
 
 /// After a clock jump: empties the tf buffer (transforms of the old timeline would answer
-/// lookups at the new one's stamps) and subscribes anew, because tf2's listener, which clears
-/// the buffer itself when it notices the jump, also drops the latched /tf_static transforms
-/// that are sent only once per subscription.
+/// lookups at the new one's stamps) and subscribes anew, with a listener that has no
+/// old-timeline update time. Static transforms survive the clear (tf2's static caches ignore
+/// it), and the new subscription receives the latched /tf_static again.
 inline void restartTf(tf2_ros::Buffer& buffer,
                       std::unique_ptr<tf2_ros::TransformListener>& listener, ros::NodeHandle& nh) {
   listener.reset();
