@@ -6,7 +6,6 @@
 #include <sensor_msgs/point_cloud_conversion.h>
 
 #include <chrono>
-#include <deque>
 #include <functional>
 
 #include "downstream_perception/core/voxel/depth_rays.h"
@@ -69,11 +68,11 @@ void VoxelObstacleLayer::onCameraInfo(Source* s, const sensor_msgs::CameraInfoCo
     reject(s, "camera_info: " + why);
     return;
   }
-  std::deque<sensor_msgs::ImageConstPtr> waited;
+  std::vector<sensor_msgs::ImageConstPtr> waited;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     s->camera = cam;
-    waited.swap(s->waiting_for_camera);
+    waited = s->waiting_for_camera.release();
   }
   for (const auto& image : waited) integrateDepth(s, image, cam);
 }
@@ -90,11 +89,7 @@ void VoxelObstacleLayer::onDepth(Source* s, const sensor_msgs::ImageConstPtr& ms
     if (!cam && well_formed) {
       // The image overtook its first CameraInfo (two topics on two connections: nothing orders
       // them at start-up or in a bag replay). It waits, at most tf_queue_size of them.
-      s->waiting_for_camera.push_back(msg);
-      if (s->waiting_for_camera.size() > static_cast<std::size_t>(s->tf_queue_size)) {
-        pushed_out = s->waiting_for_camera.front();
-        s->waiting_for_camera.pop_front();
-      }
+      pushed_out = s->waiting_for_camera.hold(msg);
     }
   }
   if (!well_formed) {

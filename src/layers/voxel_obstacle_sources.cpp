@@ -120,6 +120,7 @@ void VoxelObstacleLayer::readSource(const std::string& name) {
     return;
   }
   s->depth = data_type == "DepthImage";
+  s->waiting_for_camera = WaitingImages(static_cast<std::size_t>(s->tf_queue_size));
   s->frustum = clearing_mode == "frustum";
   s->scan = data_type == "LaserScan";
   s->legacy_cloud = data_type == "PointCloud";

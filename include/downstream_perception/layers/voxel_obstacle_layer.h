@@ -28,6 +28,7 @@
 #include "downstream_perception/core/tsdf/tsdf_integrator.h"
 #include "downstream_perception/core/voxel/scan_rays.h"
 #include "downstream_perception/core/voxel/voxel_map.h"
+#include "downstream_perception/ros/common/camera_info_cache.h"
 #include "downstream_perception/ros/common/config_errors.h"
 #include "downstream_perception/ros/common/filtered_subscription.h"
 #include "downstream_perception/ros/common/reconfigure_host.h"
@@ -83,8 +84,8 @@ class VoxelObstacleLayer : public Layer {
     ros::Subscriber info_sub;
     // Guarded by the layer's mutex_.
     std::optional<PinholeCamera> camera;
-    /// Depth images that came before the first CameraInfo (oldest first, <= tf_queue_size).
-    std::deque<sensor_msgs::ImageConstPtr> waiting_for_camera;
+    /// Depth images that came before the first CameraInfo (at most tf_queue_size).
+    WaitingImages waiting_for_camera;
     std::size_t received = 0;
     std::size_t integrated = 0;
     std::size_t rejected = 0;

@@ -27,6 +27,7 @@ from downstream_perception.ros.util import laser_scan, transform_stamped, wait_u
 
 START_S = 1000.0
 JUMP_S = 30.0
+PLANE_1M = struct.pack("<192f", *([1.0] * 192))  # the 16 x 12 depth image's data, 32FC1
 
 
 class SimClock:
@@ -138,7 +139,7 @@ class ClockJumpTest(unittest.TestCase):
         cls.info_pub.publish(info)
         image = Image(height=height, width=width, encoding="32FC1", is_bigendian=0, step=4 * width)
         image.header = info.header
-        image.data = struct.pack(f"<{width * height}f", *([1.0] * (width * height)))
+        image.data = PLANE_1M
         cls.depth_pub.publish(image)
 
     def newest(self, key: str) -> float:

@@ -16,11 +16,32 @@
 
 namespace downstream_perception {
 
+/// Images held until what they need arrives (their CameraInfo), oldest first, at most
+/// `max_waiting` of them. Not thread-safe: the owner's lock guards it.
+class WaitingImages {
+ public:
+  explicit WaitingImages(std::size_t max_waiting = 0) : max_waiting_(max_waiting) {}
+
+  /// Holds `image`. Returns the image it pushes out when max_waiting images already wait (the
+  /// oldest; `image` itself when max_waiting is 0), else null.
+  sensor_msgs::ImageConstPtr hold(const sensor_msgs::ImageConstPtr& image);
+  /// Removes and returns the held images of frame `frame_id` (all of them for null), oldest
+  /// first.
+  std::vector<sensor_msgs::ImageConstPtr> release(const std::string* frame_id = nullptr);
+  void clear() { waiting_.clear(); }
+  std::size_t size() const { return waiting_.size(); }
+  std::size_t maxWaiting() const { return max_waiting_; }
+
+ private:
+  std::size_t max_waiting_;
+  std::deque<sensor_msgs::ImageConstPtr> waiting_;  ///< oldest first
+};
+
 /// Not thread-safe: the owner's lock guards it.
 class CameraInfoCache {
  public:
   /// At most `max_waiting` images wait (0: none wait; an image without CameraInfo is dropped).
-  explicit CameraInfoCache(std::size_t max_waiting) : max_waiting_(max_waiting) {}
+  explicit CameraInfoCache(std::size_t max_waiting) : waiting_(max_waiting) {}
 
   /// Stores `info` as its frame's latest; returns the images that waited for that frame,
   /// oldest first (the caller checks them against `info` like any other image).
@@ -29,20 +50,19 @@ class CameraInfoCache {
   /// The latest CameraInfo of `frame_id`, or null before its first.
   const sensor_msgs::CameraInfo* find(const std::string& frame_id) const;
 
-  /// Holds an image whose frame has no CameraInfo yet. Returns the image it pushes out when
-  /// max_waiting images already wait (the oldest; `image` itself when max_waiting is 0), else
-  /// null.
-  sensor_msgs::ImageConstPtr wait(const sensor_msgs::ImageConstPtr& image);
+  /// Holds an image whose frame has no CameraInfo yet (WaitingImages::hold).
+  sensor_msgs::ImageConstPtr wait(const sensor_msgs::ImageConstPtr& image) {
+    return waiting_.hold(image);
+  }
 
   /// Drops the waiting images (a clock jump: they belong to the old timeline).
   void clearWaiting() { waiting_.clear(); }
   std::size_t waiting() const { return waiting_.size(); }
-  std::size_t maxWaiting() const { return max_waiting_; }
+  std::size_t maxWaiting() const { return waiting_.maxWaiting(); }
 
  private:
-  std::size_t max_waiting_;
   std::map<std::string, sensor_msgs::CameraInfo> latest_;
-  std::deque<sensor_msgs::ImageConstPtr> waiting_;  ///< oldest first
+  WaitingImages waiting_;
 };
 
 }  // namespace downstream_perception
