@@ -1,6 +1,6 @@
 // How the TSDF integrator reads a voxel's depth from the 2 x 2 pixels around its projection:
-// interpolated on planes, the nearest pixel across depth edges, the farthest of the four across
-// a crease (issue 22, defect 4).
+// interpolated on planes, the nearest pixel across depth edges, the two planes meeting there
+// across a crease (issue 22, defect 4).
 #pragma once
 
 #include <cstdint>
@@ -38,7 +38,7 @@ struct DepthWindowScratch {
 /// Every window's class into out (w x h). A window's bend (m) is how far from a plane its
 /// pixels lie: the larger of its twist and, along its rows and columns, its pixels' kinks
 /// (second differences of inverse depth; a crease along the rows or columns has no twist),
-/// times z^2; 0 on a plane (depth_windows.cpp, windowBends). Returns the threshold: max(
+/// times z^2; 0 on a plane (depth_windows.cpp, windowBend). Returns the threshold: max(
 /// crease_min, crease_noise_factor x the median bend of every kNoiseStride-th continuous
 /// window); on a plane under independent depth noise about 5e-5 of the windows bend more than
 /// 4 x the median (simulated). depth: m (NaN or +Inf: invalid); inverse: 1 / depth, 0 where
