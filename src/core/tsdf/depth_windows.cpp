@@ -8,7 +8,10 @@
 
 namespace downstream_perception {
 
-namespace {
+// External linkage on purpose (DP_AVX2_CLONES): a function local to this file would have its
+// clone chosen while the library loads, before a sanitizer's runtime is up (ThreadSanitizer
+// crashed there).
+namespace detail {
 
 /// |Second difference| of inverse depth through each pixel along its row (kink_row) and its
 /// column (kink_column); 0 on the image's border. Not checked for depth edges or invalid
@@ -87,7 +90,7 @@ void classifyWindows(const float* depth, const float* inverse, const float* kink
             out + static_cast<std::size_t>(h) * w, DepthWindow::kNearestPixel);
 }
 
-}  // namespace
+}  // namespace detail
 
 float classifyDepthWindows(const float* depth, const float* inverse, int w, int h,
                            const DepthWindowSettings& settings, DepthWindowScratch* scratch,
@@ -101,14 +104,15 @@ float classifyDepthWindows(const float* depth, const float* inverse, int w, int 
   scratch->kink_column.resize(n);
   const float* kr = scratch->kink_row.data();
   const float* kc = scratch->kink_column.data();
-  pixelKinks(inverse, w, h, scratch->kink_row.data(), scratch->kink_column.data());
+  detail::pixelKinks(inverse, w, h, scratch->kink_row.data(), scratch->kink_column.data());
   // The noise level from a sample of the windows (the last row and column hold none).
   std::vector<float>& sample = scratch->sample;
   sample.clear();
   const std::size_t stride = static_cast<std::size_t>(w);
   for (std::size_t i = 0; i < n - stride; i += kNoiseStride) {
     if (i % stride == stride - 1) continue;
-    const float bend = windowBend(depth, inverse, kr, kc, i, stride, settings.max_step).bend;
+    const float bend =
+        detail::windowBend(depth, inverse, kr, kc, i, stride, settings.max_step).bend;
     if (bend >= 0.0f) sample.push_back(bend);
   }
   float threshold = settings.crease_min;
@@ -117,7 +121,7 @@ float classifyDepthWindows(const float* depth, const float* inverse, int w, int 
     std::nth_element(sample.begin(), middle, sample.end());
     threshold = std::max(threshold, settings.crease_noise_factor * *middle);
   }
-  classifyWindows(depth, inverse, kr, kc, w, h, settings.max_step, threshold, out);
+  detail::classifyWindows(depth, inverse, kr, kc, w, h, settings.max_step, threshold, out);
   return threshold;
 }
 
