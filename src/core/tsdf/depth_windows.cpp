@@ -90,7 +90,134 @@ void classifyWindows(const float* depth, const float* inverse, const float* kink
             out + static_cast<std::size_t>(h) * w, DepthWindow::kNearestPixel);
 }
 
+/// Signed slope change across each window's two pixels along a line, times z^2 (m): for the
+/// window between pixels j and j + 1 of a line (stride `step`), (i[j + 2] - i[j + 1]) - (i[j] -
+/// i[j - 1]): the whole kink of a crease between j and j + 1 wherever it lies there (the
+/// windows beside it see a share of it), 0 on a plane. 0 where any of the four pixels is
+/// invalid or they span more than max_step (m): no evidence. `first`, `last`: the windows
+/// along the line that have both outer pixels.
+DP_AVX2_CLONES
+void lineSlopeChanges(const float* depth, const float* inverse, int w, int h, bool along_rows,
+                      float max_step, float* out) {
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  // Only the windows the loop below leaves out are zeroed (first and last columns or rows).
+  if (along_rows) {
+    for (int v = 0; v < h; ++v) {
+      float* o = out + static_cast<std::size_t>(v) * w;
+      o[0] = 0.0f;
+      std::fill(o + std::max(1, w - 2), o + w, 0.0f);
+    }
+  } else {
+    std::fill(out, out + w, 0.0f);
+    std::fill(out + static_cast<std::size_t>(std::max(1, h - 2)) * w, out + n, 0.0f);
+  }
+  const std::ptrdiff_t step = along_rows ? 1 : w;
+  const int u_begin = along_rows ? 1 : 0, u_end = along_rows ? w - 2 : w;
+  const int v_begin = along_rows ? 0 : 1, v_end = along_rows ? h : h - 2;
+  for (int v = v_begin; v < v_end; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * w;
+    const float* i = inverse + row;
+    const float* d = depth + row;
+    float* o = out + row;
+    for (int u = u_begin; u < u_end; ++u) {
+      const float p0 = i[u - step], p1 = i[u], p2 = i[u + step], p3 = i[u + 2 * step];
+      const float d0 = d[u - step], d1 = d[u], d2 = d[u + step], d3 = d[u + 2 * step];
+      const float lo = std::min(std::min(d0, d1), std::min(d2, d3));
+      const float hi = std::max(std::max(d0, d1), std::max(d2, d3));
+      const bool ok =
+          (p0 != 0.0f) & (p1 != 0.0f) & (p2 != 0.0f) & (p3 != 0.0f) & (hi - lo <= max_step);
+      const float change = ((p3 - p2) - (p1 - p0)) * d1 * d1;
+      o[u] = ok ? change : 0.0f;
+    }
+  }
+}
+
+/// Sums of the 2 r + 2 neighbouring lines' slope changes at each window (its own two lines and r
+/// on each side), along the crease (across the lines): a crease running along the lines adds
+/// up, depth noise only as the square root. along_rows: the lines are rows, and a window (u, v)
+/// sums rows v - r .. v + 1 + r at column u; else columns u - r .. u + 1 + r in row v. Plain
+/// sums over rows of the image, which the compiler vectorises.
+DP_AVX2_CLONES
+void sumAlongCrease(const float* changes, int w, int h, bool along_rows, int r, float* out) {
+  for (int v = 0; v < h; ++v) {
+    float* o = out + static_cast<std::size_t>(v) * w;
+    if (along_rows) {
+      // A running sum down the columns: the row entering the span added, the one leaving it
+      // taken off (rounding drifts by ~1e-7 of the sums over an image: far below the noise).
+      if (v == 0) {
+        std::fill(o, o + w, 0.0f);
+        for (int k = 0; k < std::min(h, r + 2); ++k) {
+          const float* c = changes + static_cast<std::size_t>(k) * w;
+          for (int u = 0; u < w; ++u) o[u] += c[u];
+        }
+        continue;
+      }
+      const float* previous = o - w;
+      const int enter = v + 1 + r, leave = v - r - 1;
+      std::copy(previous, previous + w, o);
+      if (enter < h) {
+        const float* c = changes + static_cast<std::size_t>(enter) * w;
+        for (int u = 0; u < w; ++u) o[u] += c[u];
+      }
+      if (leave >= 0) {
+        const float* c = changes + static_cast<std::size_t>(leave) * w;
+        for (int u = 0; u < w; ++u) o[u] -= c[u];
+      }
+    } else {
+      const float* c = changes + static_cast<std::size_t>(v) * w;
+      std::fill(o, o + w, 0.0f);
+      for (int k = -r; k <= r + 1; ++k) {
+        const int lo = std::max(0, -k), hi = std::min(w, w - k);
+        for (int u = lo; u < hi; ++u) o[u] += c[u + k];
+      }
+    }
+  }
+}
+
+/// Windows read as one plane whose summed slope change (sumAlongCrease) exceeds the threshold
+/// and is the largest across the crease (the windows beside it see a share of it) become
+/// creases of that direction (the larger excess if both). rows: summed along the rows' slope
+/// changes (a crease between the window's columns); columns: the columns' (between its rows).
+DP_AVX2_CLONES
+void addSummedCreases(const float* rows, const float* columns, int w, int h, float row_threshold,
+                      float column_threshold, DepthWindow* out) {
+  const float row_scale = 1.0f / row_threshold, column_scale = 1.0f / column_threshold;
+  for (int v = 1; v + 2 < h; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * w;
+    const float* r = rows + row;
+    const float* c = columns + row;
+    std::uint8_t* classes = reinterpret_cast<std::uint8_t*>(out + row);
+    for (int u = 1; u + 2 < w; ++u) {
+      const float rr = std::abs(r[u]) * row_scale, cc = std::abs(c[u]) * column_scale;
+      const bool across_columns = (rr > 1.0f) & (rr >= std::abs(r[u - 1]) * row_scale) &
+                                  (rr > std::abs(r[u + 1]) * row_scale);
+      const bool across_rows = (cc > 1.0f) & (cc >= std::abs(c[u - w]) * column_scale) &
+                               (cc > std::abs(c[u + w]) * column_scale);
+      const std::uint8_t crease = (across_columns & (rr >= cc)) | !across_rows ? 3 : 2;
+      const bool plane = classes[u] == 1;
+      classes[u] = plane & (across_columns | across_rows) ? crease : classes[u];
+    }
+  }
+}
+
 }  // namespace detail
+
+namespace {
+
+/// factor x the median |value| of every kNoiseStride-th nonzero value (at least floor).
+float noiseThreshold(const float* values, std::size_t n, float factor, float floor,
+                     std::vector<float>* sample) {
+  sample->clear();
+  for (std::size_t i = 0; i < n; i += kNoiseStride) {
+    if (values[i] != 0.0f) sample->push_back(std::abs(values[i]));
+  }
+  if (sample->empty()) return floor;
+  const auto middle = sample->begin() + static_cast<std::ptrdiff_t>(sample->size() / 2);
+  std::nth_element(sample->begin(), middle, sample->end());
+  return std::max(floor, factor * *middle);
+}
+
+}  // namespace
 
 float classifyDepthWindows(const float* depth, const float* inverse, int w, int h,
                            const DepthWindowSettings& settings, DepthWindowScratch* scratch,
@@ -122,6 +249,31 @@ float classifyDepthWindows(const float* depth, const float* inverse, int w, int 
     threshold = std::max(threshold, settings.crease_noise_factor * *middle);
   }
   detail::classifyWindows(depth, inverse, kr, kc, w, h, settings.max_step, threshold, out);
+  if (settings.crease_sum_radius > 0 && threshold > settings.crease_min && w >= 4 && h >= 4) {
+    // Under depth noise (the threshold above the floor) a window's own kinks drown a crease;
+    // summed along it over neighbouring lines it stands out again. Without noise they see every
+    // crease, and the sums would only add windows beside slanting ones (the kink buffers are
+    // free now).
+    scratch->slope_row.resize(n);
+    scratch->slope_column.resize(n);
+    float* rows = scratch->kink_row.data();
+    float* columns = scratch->kink_column.data();
+    detail::lineSlopeChanges(depth, inverse, w, h, true, settings.max_step,
+                             scratch->slope_row.data());
+    detail::lineSlopeChanges(depth, inverse, w, h, false, settings.max_step,
+                             scratch->slope_column.data());
+    const int r = settings.crease_sum_radius;
+    detail::sumAlongCrease(scratch->slope_row.data(), w, h, true, r, rows);
+    detail::sumAlongCrease(scratch->slope_column.data(), w, h, false, r, columns);
+    // A sum of 2 r + 2 slope changes, each twice a window's kink on a curved surface: the
+    // floor asks of each line what the kinks' floor asks of a window.
+    const float floor = settings.crease_min * static_cast<float>(2 * (2 * r + 2));
+    const float row_threshold =
+        noiseThreshold(rows, n, settings.crease_sum_noise_factor, floor, &scratch->sample);
+    const float column_threshold =
+        noiseThreshold(columns, n, settings.crease_sum_noise_factor, floor, &scratch->sample);
+    detail::addSummedCreases(rows, columns, w, h, row_threshold, column_threshold, out);
+  }
   return threshold;
 }
 

@@ -4,8 +4,10 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "downstream_perception/core/tsdf/marching_cubes.h"
@@ -32,6 +34,25 @@ std::vector<float> castDepth(const PinholeCamera& camera, const Eigen::Isometry3
   }
   return depth;
 }
+
+/// A ray caster for castDepth over axis-aligned planes (a floor, walls), each seen from one
+/// side: plane k is {p[axis] = offset}, hit by rays moving along `towards` (+1 or -1) on its axis.
+struct AxisPlanes {
+  struct Plane {
+    int axis;
+    double offset;
+    int towards;
+  };
+  std::vector<Plane> planes;
+
+  double operator()(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
+    double t = std::numeric_limits<double>::infinity();
+    for (const Plane& p : planes) {
+      if (d[p.axis] * p.towards > 0.0) t = std::min(t, (p.offset - o[p.axis]) / d[p.axis]);
+    }
+    return t;
+  }
+};
 
 /// Frames fused into one map, kept for coverage checks.
 struct FusedFrames {

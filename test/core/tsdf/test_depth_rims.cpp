@@ -565,13 +565,7 @@ TEST(DepthRims, AWallSeenAtGrazingKeepsItsReachIntoTheCornerItMakesWithTheWallAc
   // corner meshed, as before the occluding-edge test (0.78 with rims wherever the end wall
   // forms a plane of its own; 0.88 when the last pixel's fit was not compared); 0.98 with the
   // second look (the side wall's plane gives its far pixels an incidence and a reach).
-  const auto hit = [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
-    double t = std::numeric_limits<double>::infinity();
-    if (d.z() < 0.0) t = std::min(t, -o.z() / d.z());          // floor
-    if (d.y() < 0.0) t = std::min(t, (-1.2 - o.y()) / d.y());  // side wall
-    if (d.x() > 0.0) t = std::min(t, (9.0 - o.x()) / d.x());   // end wall
-    return t;
-  };
+  const AxisPlanes hit{{{2, 0.0, -1}, {1, -1.2, -1}, {0, 9.0, +1}}};  // floor, side, end wall
   const PinholeCamera camera = benchmarkCamera();
   TsdfConfig c;
   c.voxel_size_m = 0.02;

@@ -1,6 +1,7 @@
 // How the TSDF integrator reads a voxel's depth from the 2 x 2 pixels around its projection:
 // interpolated on planes, the nearest pixel across depth edges, the two planes meeting there
-// across a crease (issue 22, defect 4).
+// across a crease, found by its window's kinks or, under depth noise, summed along its line
+// (issue 22, defect 4).
 #pragma once
 
 #include <cstdint>
@@ -26,13 +27,21 @@ struct DepthWindowSettings {
   /// Bent more than this many times the frame's median bend to be a crease: under noise a
   /// plane's windows are bent too.
   float crease_noise_factor = 4.0f;
+  /// Also sum each window's slope change over this many lines on each side along the crease
+  /// (0: off): a crease under depth noise (depth_windows.cpp, sumAlongCrease).
+  int crease_sum_radius = 0;
+  /// A summed slope change beyond this many times the frame's median one is a crease (Gaussian
+  /// noise: 6 x the median |value| is 4 sigma, 6e-5 of a plane's windows).
+  float crease_sum_noise_factor = 6.0f;
 };
 
 /// Scratch reused from frame to frame.
 struct DepthWindowScratch {
-  std::vector<float> kink_row;     ///< per pixel, inverse depth (depth_windows.cpp)
-  std::vector<float> kink_column;  ///< per pixel, inverse depth
-  std::vector<float> sample;       ///< every kNoiseStride-th continuous window's bend
+  std::vector<float> kink_row;      ///< per pixel, inverse depth (depth_windows.cpp)
+  std::vector<float> kink_column;   ///< per pixel, inverse depth
+  std::vector<float> sample;        ///< every kNoiseStride-th continuous window's bend
+  std::vector<float> slope_row;     ///< per window, slope change along its row (m)
+  std::vector<float> slope_column;  ///< ... along its column
 };
 
 /// Every window's class into out (w x h). A window's bend (m) is how far from a plane its
@@ -41,8 +50,11 @@ struct DepthWindowScratch {
 /// times z^2; 0 on a plane (depth_windows.cpp, windowBend). Returns the threshold: max(
 /// crease_min, crease_noise_factor x the median bend of every kNoiseStride-th continuous
 /// window); on a plane under independent depth noise about 5e-5 of the windows bend more than
-/// 4 x the median (simulated). depth: m (NaN or +Inf: invalid); inverse: 1 / depth, 0 where
-/// invalid.
+/// 4 x the median (simulated). Where that threshold lies above crease_min (noise governs it) and
+/// crease_sum_radius > 0, a plane window whose slope change summed along 2 r + 2 lines exceeds
+/// crease_sum_noise_factor x the median |sum|, and is the largest across the lines, is a crease
+/// too (a crease's kink adds up along its line, the noise as the square root). depth: m (NaN or
+/// +Inf: invalid); inverse: 1 / depth, 0 where invalid.
 float classifyDepthWindows(const float* depth, const float* inverse, int w, int h,
                            const DepthWindowSettings& settings, DepthWindowScratch* scratch,
                            DepthWindow* out);
