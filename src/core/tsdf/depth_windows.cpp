@@ -90,91 +90,44 @@ void classifyWindows(const float* depth, const float* inverse, const float* kink
             out + static_cast<std::size_t>(h) * w, DepthWindow::kNearestPixel);
 }
 
-/// Signed slope change across each window's two pixels along a line, times z^2 (m): for the
-/// window between pixels j and j + 1 of a line (stride `step`), (i[j + 2] - i[j + 1]) - (i[j] -
-/// i[j - 1]): the whole kink of a crease between j and j + 1 wherever it lies there (the
-/// windows beside it see a share of it), 0 on a plane. 0 where any of the four pixels is
-/// invalid or they span more than max_step (m): no evidence. `first`, `last`: the windows
-/// along the line that have both outer pixels.
+/// The signed slope change across a window's two pixels p1, p2 along a line, from the pixels
+/// before and after them: (p3 - p2) - (p1 - p0) in inverse depth, times z^2 (m): the whole kink
+/// of a crease between p1 and p2 wherever it lies there (the windows beside it see a share of
+/// it), 0 on a plane. 0 where a pixel is invalid or the four span more than max_step (m): no
+/// evidence.
+inline float slopeChange(const float* i, const float* d, std::ptrdiff_t step, float max_step) {
+  const float p0 = i[-step], p1 = i[0], p2 = i[step], p3 = i[2 * step];
+  const float d0 = d[-step], d1 = d[0], d2 = d[step], d3 = d[2 * step];
+  const float lo = std::min(std::min(d0, d1), std::min(d2, d3));
+  const float hi = std::max(std::max(d0, d1), std::max(d2, d3));
+  const bool ok = (p0 != 0.0f) & (p1 != 0.0f) & (p2 != 0.0f) & (p3 != 0.0f) & (hi - lo <= max_step);
+  return ok ? ((p3 - p2) - (p1 - p0)) * d1 * d1 : 0.0f;
+}
+
+/// One image row's slope changes: along the row (step 1, windows 1 .. w - 3) or, for a row v in
+/// 1 .. h - 3, along the columns (step w); 0 elsewhere.
 DP_AVX2_CLONES
-void lineSlopeChanges(const float* depth, const float* inverse, int w, int h, bool along_rows,
-                      float max_step, float* out) {
-  const std::size_t n = static_cast<std::size_t>(w) * h;
-  // Only the windows the loop below leaves out are zeroed (first and last columns or rows).
-  if (along_rows) {
-    for (int v = 0; v < h; ++v) {
-      float* o = out + static_cast<std::size_t>(v) * w;
-      o[0] = 0.0f;
-      std::fill(o + std::max(1, w - 2), o + w, 0.0f);
-    }
-  } else {
-    std::fill(out, out + w, 0.0f);
-    std::fill(out + static_cast<std::size_t>(std::max(1, h - 2)) * w, out + n, 0.0f);
+void rowSlopeChanges(const float* inverse_row, const float* depth_row, int w, std::ptrdiff_t step,
+                     float max_step, float* out) {
+  const int first = step == 1 ? 1 : 0, last = step == 1 ? w - 3 : w - 1;
+  std::fill(out, out + first, 0.0f);
+  for (int u = first; u <= last; ++u) {
+    out[u] = slopeChange(inverse_row + u, depth_row + u, step, max_step);
   }
-  const std::ptrdiff_t step = along_rows ? 1 : w;
-  const int u_begin = along_rows ? 1 : 0, u_end = along_rows ? w - 2 : w;
-  const int v_begin = along_rows ? 0 : 1, v_end = along_rows ? h : h - 2;
-  for (int v = v_begin; v < v_end; ++v) {
-    const std::size_t row = static_cast<std::size_t>(v) * w;
-    const float* i = inverse + row;
-    const float* d = depth + row;
-    float* o = out + row;
-    for (int u = u_begin; u < u_end; ++u) {
-      const float p0 = i[u - step], p1 = i[u], p2 = i[u + step], p3 = i[u + 2 * step];
-      const float d0 = d[u - step], d1 = d[u], d2 = d[u + step], d3 = d[u + 2 * step];
-      const float lo = std::min(std::min(d0, d1), std::min(d2, d3));
-      const float hi = std::max(std::max(d0, d1), std::max(d2, d3));
-      const bool ok =
-          (p0 != 0.0f) & (p1 != 0.0f) & (p2 != 0.0f) & (p3 != 0.0f) & (hi - lo <= max_step);
-      const float change = ((p3 - p2) - (p1 - p0)) * d1 * d1;
-      o[u] = ok ? change : 0.0f;
-    }
+  std::fill(out + last + 1, out + w, 0.0f);
+}
+
+/// out[u] = the sum of in[u - r .. u + 1 + r] (clipped to the row).
+DP_AVX2_CLONES
+void boxSumRow(const float* in, int w, int r, float* out) {
+  std::fill(out, out + w, 0.0f);
+  for (int k = -r; k <= r + 1; ++k) {
+    const int lo = std::max(0, -k), hi = std::min(w, w - k);
+    for (int u = lo; u < hi; ++u) out[u] += in[u + k];
   }
 }
 
-/// Sums of the 2 r + 2 neighbouring lines' slope changes at each window (its own two lines and r
-/// on each side), along the crease (across the lines): a crease running along the lines adds
-/// up, depth noise only as the square root. along_rows: the lines are rows, and a window (u, v)
-/// sums rows v - r .. v + 1 + r at column u; else columns u - r .. u + 1 + r in row v. Plain
-/// sums over rows of the image, which the compiler vectorises.
-DP_AVX2_CLONES
-void sumAlongCrease(const float* changes, int w, int h, bool along_rows, int r, float* out) {
-  for (int v = 0; v < h; ++v) {
-    float* o = out + static_cast<std::size_t>(v) * w;
-    if (along_rows) {
-      // A running sum down the columns: the row entering the span added, the one leaving it
-      // taken off (rounding drifts by ~1e-7 of the sums over an image: far below the noise).
-      if (v == 0) {
-        std::fill(o, o + w, 0.0f);
-        for (int k = 0; k < std::min(h, r + 2); ++k) {
-          const float* c = changes + static_cast<std::size_t>(k) * w;
-          for (int u = 0; u < w; ++u) o[u] += c[u];
-        }
-        continue;
-      }
-      const float* previous = o - w;
-      const int enter = v + 1 + r, leave = v - r - 1;
-      std::copy(previous, previous + w, o);
-      if (enter < h) {
-        const float* c = changes + static_cast<std::size_t>(enter) * w;
-        for (int u = 0; u < w; ++u) o[u] += c[u];
-      }
-      if (leave >= 0) {
-        const float* c = changes + static_cast<std::size_t>(leave) * w;
-        for (int u = 0; u < w; ++u) o[u] -= c[u];
-      }
-    } else {
-      const float* c = changes + static_cast<std::size_t>(v) * w;
-      std::fill(o, o + w, 0.0f);
-      for (int k = -r; k <= r + 1; ++k) {
-        const int lo = std::max(0, -k), hi = std::min(w, w - k);
-        for (int u = lo; u < hi; ++u) o[u] += c[u + k];
-      }
-    }
-  }
-}
-
-/// Windows read as one plane whose summed slope change (sumAlongCrease) exceeds the threshold
+/// Windows read as one plane whose summed slope change (summedSlopeChanges) exceeds the threshold
 /// and is the largest across the crease (the windows beside it see a share of it) become
 /// creases of that direction (the larger excess if both). rows: summed along the rows' slope
 /// changes (a crease between the window's columns); columns: the columns' (between its rows).
@@ -203,6 +156,56 @@ void addSummedCreases(const float* rows, const float* columns, int w, int h, flo
 }  // namespace detail
 
 namespace {
+
+/// The windows' slope changes summed along the crease, row by row (the kink buffers are free
+/// once the windows are classified): rows[v] sums the row slope changes of lines v - r .. v + 1
+/// + r (a running sum over a ring of the last 2 r + 3 lines: the line entering added, the one
+/// leaving taken off; rounding drifts by ~1e-7 of the sums over an image, far below the
+/// noise), columns[v] the column slope changes of row v over columns u - r .. u + 1 + r. A
+/// crease running along the lines adds up, depth noise only as the square root.
+void summedSlopeChanges(const float* depth, const float* inverse, int w, int h, float max_step,
+                        int r, DepthWindowScratch* scratch, float* rows, float* columns) {
+  const int slots = 2 * r + 3;
+  const std::size_t width = static_cast<std::size_t>(w);
+  scratch->line_ring.resize(static_cast<std::size_t>(slots) * width);
+  scratch->line.resize(width);
+  const auto line = [&](int k) {  // row k's row slope changes, kept in the ring
+    float* slot = scratch->line_ring.data() + static_cast<std::size_t>(k % slots) * width;
+    const std::size_t at = static_cast<std::size_t>(k) * width;
+    detail::rowSlopeChanges(inverse + at, depth + at, w, 1, max_step, slot);
+    return slot;
+  };
+  for (int v = 0; v < h; ++v) {
+    float* o = rows + static_cast<std::size_t>(v) * width;
+    if (v == 0) {
+      std::fill(o, o + w, 0.0f);
+      for (int k = 0; k < std::min(h, r + 2); ++k) {
+        const float* c = line(k);
+        for (int u = 0; u < w; ++u) o[u] += c[u];
+      }
+    } else {
+      std::copy(o - width, o, o);
+      const int enter = v + 1 + r, leave = v - r - 1;
+      if (enter < h) {
+        const float* c = line(enter);
+        for (int u = 0; u < w; ++u) o[u] += c[u];
+      }
+      if (leave >= 0) {
+        const float* c =
+            scratch->line_ring.data() + static_cast<std::size_t>(leave % slots) * width;
+        for (int u = 0; u < w; ++u) o[u] -= c[u];
+      }
+    }
+    float* column_row = columns + static_cast<std::size_t>(v) * width;
+    if (v >= 1 && v + 3 <= h) {
+      const std::size_t at = static_cast<std::size_t>(v) * width;
+      detail::rowSlopeChanges(inverse + at, depth + at, w, w, max_step, scratch->line.data());
+      detail::boxSumRow(scratch->line.data(), w, r, column_row);
+    } else {
+      std::fill(column_row, column_row + w, 0.0f);
+    }
+  }
+}
 
 /// factor x the median |value| of every kNoiseStride-th nonzero value (at least floor).
 float noiseThreshold(const float* values, std::size_t n, float factor, float floor,
@@ -254,17 +257,11 @@ float classifyDepthWindows(const float* depth, const float* inverse, int w, int 
     // summed along it over neighbouring lines it stands out again. Without noise they see every
     // crease, and the sums would only add windows beside slanting ones (the kink buffers are
     // free now).
-    scratch->slope_row.resize(n);
-    scratch->slope_column.resize(n);
-    float* rows = scratch->kink_row.data();
-    float* columns = scratch->kink_column.data();
-    detail::lineSlopeChanges(depth, inverse, w, h, true, settings.max_step,
-                             scratch->slope_row.data());
-    detail::lineSlopeChanges(depth, inverse, w, h, false, settings.max_step,
-                             scratch->slope_column.data());
     const int r = settings.crease_sum_radius;
-    detail::sumAlongCrease(scratch->slope_row.data(), w, h, true, r, rows);
-    detail::sumAlongCrease(scratch->slope_column.data(), w, h, false, r, columns);
+    summedSlopeChanges(depth, inverse, w, h, settings.max_step, r, scratch,
+                       scratch->kink_row.data(), scratch->kink_column.data());
+    const float* rows = scratch->kink_row.data();
+    const float* columns = scratch->kink_column.data();
     // A sum of 2 r + 2 slope changes, each twice a window's kink on a curved surface: the
     // floor asks of each line what the kinks' floor asks of a window.
     const float floor = settings.crease_min * static_cast<float>(2 * (2 * r + 2));

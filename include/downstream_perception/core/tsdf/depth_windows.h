@@ -37,11 +37,11 @@ struct DepthWindowSettings {
 
 /// Scratch reused from frame to frame.
 struct DepthWindowScratch {
-  std::vector<float> kink_row;      ///< per pixel, inverse depth (depth_windows.cpp)
-  std::vector<float> kink_column;   ///< per pixel, inverse depth
-  std::vector<float> sample;        ///< every kNoiseStride-th continuous window's bend
-  std::vector<float> slope_row;     ///< per window, slope change along its row (m)
-  std::vector<float> slope_column;  ///< ... along its column
+  std::vector<float> kink_row;     ///< per pixel, inverse depth (depth_windows.cpp)
+  std::vector<float> kink_column;  ///< per pixel, inverse depth
+  std::vector<float> sample;       ///< every kNoiseStride-th continuous window's bend
+  std::vector<float> line_ring;    ///< the last 2 r + 3 rows' slope changes along the rows (m)
+  std::vector<float> line;         ///< one row's slope changes along the columns (m)
 };
 
 /// Every window's class into out (w x h). A window's bend (m) is how far from a plane its
