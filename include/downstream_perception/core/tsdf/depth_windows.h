@@ -28,7 +28,7 @@ struct DepthWindowSettings {
   /// plane's windows are bent too.
   float crease_noise_factor = 4.0f;
   /// Also sum each window's slope change over this many lines on each side along the crease
-  /// (0: off): a crease under depth noise (depth_windows.cpp, sumAlongCrease).
+  /// (0: off): a crease under depth noise (depth_windows.cpp, summedSlopeChanges).
   int crease_sum_radius = 0;
   /// A summed slope change beyond this many times the frame's median one is a crease (Gaussian
   /// noise: 6 x the median |value| is 4 sigma, 6e-5 of a plane's windows).
