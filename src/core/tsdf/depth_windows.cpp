@@ -207,17 +207,22 @@ void summedSlopeChanges(const float* depth, const float* inverse, int w, int h, 
   }
 }
 
-/// factor x the median |value| of every kNoiseStride-th nonzero value (at least floor).
+/// max(floor, factor x the median of `sample`) (floor if empty); reorders the sample.
+float medianThreshold(std::vector<float>* sample, float factor, float floor) {
+  if (sample->empty()) return floor;
+  const auto middle = sample->begin() + static_cast<std::ptrdiff_t>(sample->size() / 2);
+  std::nth_element(sample->begin(), middle, sample->end());
+  return std::max(floor, factor * *middle);
+}
+
+/// medianThreshold of every kNoiseStride-th nonzero |value|.
 float noiseThreshold(const float* values, std::size_t n, float factor, float floor,
                      std::vector<float>* sample) {
   sample->clear();
   for (std::size_t i = 0; i < n; i += kNoiseStride) {
     if (values[i] != 0.0f) sample->push_back(std::abs(values[i]));
   }
-  if (sample->empty()) return floor;
-  const auto middle = sample->begin() + static_cast<std::ptrdiff_t>(sample->size() / 2);
-  std::nth_element(sample->begin(), middle, sample->end());
-  return std::max(floor, factor * *middle);
+  return medianThreshold(sample, factor, floor);
 }
 
 }  // namespace
@@ -245,12 +250,8 @@ float classifyDepthWindows(const float* depth, const float* inverse, int w, int 
         detail::windowBend(depth, inverse, kr, kc, i, stride, settings.max_step).bend;
     if (bend >= 0.0f) sample.push_back(bend);
   }
-  float threshold = settings.crease_min;
-  if (!sample.empty()) {
-    const auto middle = sample.begin() + static_cast<std::ptrdiff_t>(sample.size() / 2);
-    std::nth_element(sample.begin(), middle, sample.end());
-    threshold = std::max(threshold, settings.crease_noise_factor * *middle);
-  }
+  const float threshold =
+      medianThreshold(&sample, settings.crease_noise_factor, settings.crease_min);
   detail::classifyWindows(depth, inverse, kr, kc, w, h, settings.max_step, threshold, out);
   if (settings.crease_sum_radius > 0 && threshold > settings.crease_min && w >= 4 && h >= 4) {
     // Under depth noise (the threshold above the floor) a window's own kinks drown a crease;
