@@ -1,12 +1,28 @@
 #include "downstream_perception/core/tsdf/distance_transform_3d.h"
 
+#include "downstream_perception/core/parallel/avx2_clones.h"
+
 #include <algorithm>
 #include <cstddef>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace downstream_perception {
 
 namespace {
+
+/// Radii (voxels) up to which passes 2 and 3 use the brute-force window in 16-bit integers: a
+/// squared distance within reach plus a window's k^2 stays below 2 r^2 + 2, which fits up to
+/// r = 127. The window's cost grows with r (2 r + 1 taps per voxel), the envelope's does not,
+/// but 16 lanes a vector win throughout: on the room's ESDF updates (one thread) 2.5x faster
+/// than the envelope at r = 21, 1.1x at r = 101, the ESDF's largest.
+constexpr int kWindowMaxRadius = kEdtMaxRadius16;
+static_assert(2 * kWindowMaxRadius * kWindowMaxRadius + 1 <=
+                  std::numeric_limits<std::int16_t>::max(),
+              "the window's sums must fit 16 bits");
+
+using Narrow = std::int16_t;
 
 /// One line of the separable transform: d[i] = min_k (i - k)^2 + f[k] over the lower envelope
 /// of the parabolas rooted at the k with f[k] <= cap2; results above cap2 become kEdtFarSquared
@@ -57,45 +73,175 @@ struct LowerEnvelope {
 
 }  // namespace
 
-void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i& size,
-                               std::uint8_t seed_label, int max_distance_voxels,
-                               std::vector<std::int32_t>* out, std::vector<std::int32_t>* scratch) {
-  const int nx = size.x(), ny = size.y(), nz = size.z();
-  if (nx <= 0 || ny <= 0 || nz <= 0) {
-    out->clear();
-    return;
-  }
-  const std::size_t plane = static_cast<std::size_t>(nx) * ny;
-  out->resize(plane * nz);
-  std::int32_t* o = out->data();
-  const std::int32_t far = max_distance_voxels + 1;
-  const std::int32_t cap2 = max_distance_voxels * max_distance_voxels;
+// External linkage on purpose (DP_AVX2_CLONES): a function local to this file would have its
+// clone chosen while the library loads, before a sanitizer's runtime is up. Every loop runs
+// along a row of x (or a plane), so it vectorises.
+namespace detail {
 
-  // Pass 1 (z), swept plane by plane so memory is read in order: distance along z to the
-  // nearest seed of the same (x, y) column, capped at `far`; then squared.
-  std::vector<std::int32_t>& run = *scratch;
-  run.assign(plane, far);
+/// Pass 1: squared distance along z (nz planes of `plane` voxels) to the nearest voxel labelled
+/// `seed` in the same column; `far_squared` from `far` voxels on. `run` holds a plane.
+template <typename T>
+void columnPass(const std::uint8_t* labels, std::size_t plane, int nz, std::uint8_t seed, T far,
+                T far_squared, T* run, T* out) {
+  std::fill(run, run + plane, far);
   for (int z = 0; z < nz; ++z) {
     const std::uint8_t* l = labels + plane * z;
-    std::int32_t* oz = o + plane * z;
+    T* oz = out + plane * z;
     for (std::size_t i = 0; i < plane; ++i) {
-      run[i] = l[i] == seed_label ? 0 : std::min(run[i] + 1, far);
+      run[i] = l[i] == seed ? T{0} : std::min(static_cast<T>(run[i] + 1), far);
       oz[i] = run[i];
     }
   }
-  std::fill(run.begin(), run.end(), far);
+  std::fill(run, run + plane, far);
   for (int z = nz - 1; z >= 0; --z) {
     const std::uint8_t* l = labels + plane * z;
-    std::int32_t* oz = o + plane * z;
+    T* oz = out + plane * z;
     for (std::size_t i = 0; i < plane; ++i) {
-      run[i] = l[i] == seed_label ? 0 : std::min(run[i] + 1, far);
-      const std::int32_t g = std::min(oz[i], run[i]);
-      oz[i] = g < far ? g * g : kEdtFarSquared;
+      run[i] = l[i] == seed ? T{0} : std::min(static_cast<T>(run[i] + 1), far);
+      const T g = std::min(oz[i], run[i]);
+      oz[i] = g < far ? static_cast<T>(g * g) : far_squared;
     }
   }
+}
 
-  // A line that is all seeds (0) or has no seed within reach stays as it is: with dense seeds
-  // (free space, for the distances of occupied voxels) most lines are skipped.
+DP_AVX2_CLONES
+void columnPassWide(const std::uint8_t* labels, std::size_t plane, int nz, std::uint8_t seed,
+                    std::int32_t far, std::int32_t* run, std::int32_t* out) {
+  columnPass<std::int32_t>(labels, plane, nz, seed, far, kEdtFarSquared, run, out);
+}
+
+DP_AVX2_CLONES
+void columnPassNarrow(const std::uint8_t* labels, std::size_t plane, int nz, std::uint8_t seed,
+                      Narrow far, Narrow far_squared, Narrow* run, Narrow* out) {
+  columnPass<Narrow>(labels, plane, nz, seed, far, far_squared, run, out);
+}
+
+/// Whether the n values hold a seed within reach (<= cap2) and a non-seed (> 0): else a pass
+/// leaves them as they are.
+template <typename T>
+bool needsPass(const T* v, std::size_t n, T cap2) {
+  T lo = std::numeric_limits<T>::max(), hi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = std::min(lo, v[i]);
+    hi = std::max(hi, v[i]);
+  }
+  return lo <= cap2 && hi > 0;
+}
+
+DP_AVX2_CLONES
+bool needsPassWide(const std::int32_t* v, std::size_t n, std::int32_t cap2) {
+  return needsPass(v, n, cap2);
+}
+
+DP_AVX2_CLONES
+bool needsPassNarrow(const Narrow* v, std::size_t n, Narrow cap2) {
+  return needsPass(v, n, cap2);
+}
+
+/// The y pass within radius r, by brute force over the 2 r + 1 rows around each row: row y of
+/// `out` = min over |k| <= r of row y + k of `in` (a z plane, nx x ny) + k^2, above cap2
+/// `far_squared`. A row whose smallest value + k^2 exceeds cap2 cannot lower anything (the
+/// result would be capped): skipped, which in sparse regions is most of them. `row_min` holds
+/// ny values.
+DP_AVX2_CLONES
+void windowPassAcrossRows(const Narrow* in, int nx, int ny, int r, Narrow cap2, Narrow far_squared,
+                          Narrow* row_min, Narrow* out) {
+  for (int y = 0; y < ny; ++y) {
+    const Narrow* row = in + static_cast<std::size_t>(y) * nx;
+    Narrow lo = far_squared;
+    for (int x = 0; x < nx; ++x) lo = std::min(lo, row[x]);
+    row_min[y] = lo;
+  }
+  for (int y = 0; y < ny; ++y) {
+    Narrow* o = out + static_cast<std::size_t>(y) * nx;
+    std::copy(in + static_cast<std::size_t>(y) * nx, in + static_cast<std::size_t>(y + 1) * nx, o);
+    for (int k = 1; k <= r; ++k) {
+      const auto kk = static_cast<Narrow>(k * k);
+      for (const int source : {y - k, y + k}) {
+        if (source < 0 || source >= ny || row_min[source] > cap2 - kk) continue;
+        const Narrow* a = in + static_cast<std::size_t>(source) * nx;
+        for (int x = 0; x < nx; ++x) o[x] = std::min(o[x], static_cast<Narrow>(a[x] + kk));
+      }
+    }
+    for (int x = 0; x < nx; ++x) o[x] = o[x] > cap2 ? far_squared : o[x];
+  }
+}
+
+/// The x pass within radius r over one row: out[x] = min over |k| <= r of padded[r + x + k] +
+/// k^2 (`padded`: the row with r `far_squared` values on each side), above cap2 far_squared.
+DP_AVX2_CLONES
+void windowPassAlongRow(const Narrow* padded, int n, int r, Narrow cap2, Narrow far_squared,
+                        Narrow* out) {
+  const Narrow* centre = padded + r;
+  std::copy(centre, centre + n, out);
+  for (int k = 1; k <= r; ++k) {
+    const auto kk = static_cast<Narrow>(k * k);
+    const Narrow* left = centre - k;
+    const Narrow* right = centre + k;
+    for (int x = 0; x < n; ++x) {
+      out[x] = std::min(out[x], static_cast<Narrow>(std::min(left[x], right[x]) + kk));
+    }
+  }
+  for (int x = 0; x < n; ++x) out[x] = out[x] > cap2 ? far_squared : out[x];
+}
+
+/// The window's results in an output's terms: above cap2 kEdtFarSquared (32 bits) ...
+DP_AVX2_CLONES
+void widen(const Narrow* v, std::size_t n, Narrow cap2, std::int32_t* out) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = v[i] > cap2 ? kEdtFarSquared : std::int32_t{v[i]};
+}
+
+/// ... or kEdtFarSquared16 (16 bits, in place).
+DP_AVX2_CLONES
+void markFar(std::size_t n, Narrow cap2, Narrow* v) {
+  for (std::size_t i = 0; i < n; ++i) v[i] = v[i] > cap2 ? kEdtFarSquared16 : v[i];
+}
+
+}  // namespace detail
+
+namespace {
+
+/// All three passes in 16 bits (r <= kWindowMaxRadius), passes 2 and 3 by the window, in
+/// `narrow` (the box's voxels): squared distances up to cap2 = r^2, r^2 + 1 beyond.
+void windowTransform(const std::uint8_t* labels, int nx, int ny, int nz, std::uint8_t seed_label,
+                     int r, Narrow* narrow, EdtScratch* scratch) {
+  const std::size_t plane = static_cast<std::size_t>(nx) * ny;
+  const auto cap2 = static_cast<Narrow>(r * r);
+  const auto far_squared = static_cast<Narrow>(r * r + 1);
+  scratch->narrow_plane.resize(plane);
+  detail::columnPassNarrow(labels, plane, nz, seed_label, static_cast<Narrow>(r + 1), far_squared,
+                           scratch->narrow_plane.data(), narrow);
+  // narrow_row: the y pass's row minima (ny), then the x pass's padded row (nx + 2 r).
+  scratch->narrow_row.resize(
+      std::max(static_cast<std::size_t>(ny),
+               static_cast<std::size_t>(nx) + 2 * static_cast<std::size_t>(r)));
+  // Pass 2 (y): each z plane (it stays in cache), from a copy.
+  for (int z = 0; z < nz; ++z) {
+    Narrow* oz = narrow + plane * z;
+    if (!detail::needsPassNarrow(oz, plane, cap2)) continue;
+    std::copy(oz, oz + plane, scratch->narrow_plane.begin());
+    detail::windowPassAcrossRows(scratch->narrow_plane.data(), nx, ny, r, cap2, far_squared,
+                                 scratch->narrow_row.data(), oz);
+  }
+  // Pass 3 (x): each row, from a copy padded with far values.
+  Narrow* padded = scratch->narrow_row.data();
+  std::fill(padded, padded + r, far_squared);
+  std::fill(padded + r + nx, padded + 2 * r + nx, far_squared);
+  for (std::size_t row = 0; row < plane / nx * nz; ++row) {
+    Narrow* line = narrow + row * nx;
+    if (!detail::needsPassNarrow(line, nx, cap2)) continue;
+    std::copy(line, line + nx, padded + r);
+    detail::windowPassAlongRow(padded, nx, r, cap2, far_squared, line);
+  }
+}
+
+/// Passes 2 and 3 by the lower envelope, in 32 bits (any radius).
+void envelopeTransform(const std::uint8_t* labels, int nx, int ny, int nz, std::uint8_t seed_label,
+                       int r, std::int32_t* o, EdtScratch* scratch) {
+  const std::size_t plane = static_cast<std::size_t>(nx) * ny;
+  const std::int32_t cap2 = r * r;
+  scratch->run.resize(plane);
+  detail::columnPassWide(labels, plane, nz, seed_label, r + 1, scratch->run.data(), o);
   LowerEnvelope envelope;
   envelope.resize(std::max({nx, ny, nz}));
   // Pass 2 (y): each column of each z plane (the plane stays in cache).
@@ -113,16 +259,63 @@ void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i
     }
   }
   // Pass 3 (x): each row.
-  for (std::size_t r = 0; r < plane / nx * nz; ++r) {
-    std::int32_t* row = o + r * nx;
-    bool any_seed = false, any_positive = false;
-    for (int x = 0; x < nx; ++x) {
-      envelope.line[x] = row[x];
-      any_seed |= row[x] <= cap2;
-      any_positive |= row[x] > 0;
-    }
-    if (any_seed && any_positive) envelope.run(nx, cap2, row, 1);
+  for (std::size_t row = 0; row < plane / nx * nz; ++row) {
+    std::int32_t* line = o + row * nx;
+    if (!detail::needsPassWide(line, nx, cap2)) continue;
+    std::copy(line, line + nx, envelope.line.begin());
+    envelope.run(nx, cap2, line, 1);
   }
+}
+
+}  // namespace
+
+std::size_t EdtScratch::bytes() const {
+  return run.capacity() * sizeof(std::int32_t) +
+         (narrow.capacity() + narrow_plane.capacity() + narrow_row.capacity()) * sizeof(Narrow);
+}
+
+void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i& size,
+                               std::uint8_t seed_label, int max_distance_voxels,
+                               std::vector<std::int32_t>* out, EdtScratch* scratch) {
+  const int nx = size.x(), ny = size.y(), nz = size.z();
+  if (nx <= 0 || ny <= 0 || nz <= 0) {
+    out->clear();
+    return;
+  }
+  out->resize(static_cast<std::size_t>(nx) * ny * nz);
+  // Pass 1 (z) by running counts along the columns, swept plane by plane so memory is read in
+  // order; passes 2 (y) and 3 (x) by a brute-force window over the 2 r + 1 neighbours in 16
+  // bits up to kWindowMaxRadius, by the lower envelope beyond. Either way a line (or plane)
+  // that is all seeds (0) or has no seed within reach stays as it is: with dense seeds (free
+  // space, for the distances of occupied voxels) most are skipped.
+  const int r = std::max(0, max_distance_voxels);
+  if (r > kWindowMaxRadius) {
+    envelopeTransform(labels, nx, ny, nz, seed_label, r, out->data(), scratch);
+    return;
+  }
+  scratch->narrow.resize(out->size());
+  windowTransform(labels, nx, ny, nz, seed_label, r, scratch->narrow.data(), scratch);
+  detail::widen(scratch->narrow.data(), out->size(), static_cast<Narrow>(r * r), out->data());
+}
+
+void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i& size,
+                               std::uint8_t seed_label, int max_distance_voxels,
+                               std::vector<std::int16_t>* out, EdtScratch* scratch) {
+  if (max_distance_voxels > kEdtMaxRadius16) {
+    throw std::invalid_argument(
+        "boundedSquaredDistances3d: 16-bit results need a radius of at "
+        "most " +
+        std::to_string(kEdtMaxRadius16) + " voxels, got " + std::to_string(max_distance_voxels));
+  }
+  const int nx = size.x(), ny = size.y(), nz = size.z();
+  if (nx <= 0 || ny <= 0 || nz <= 0) {
+    out->clear();
+    return;
+  }
+  out->resize(static_cast<std::size_t>(nx) * ny * nz);
+  const int r = std::max(0, max_distance_voxels);
+  windowTransform(labels, nx, ny, nz, seed_label, r, out->data(), scratch);
+  detail::markFar(out->size(), static_cast<Narrow>(r * r), out->data());
 }
 
 }  // namespace downstream_perception

@@ -22,6 +22,10 @@ constexpr std::size_t kMaxMarkGridBlocks = std::size_t{1} << 22;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
+// The transform's 16-bit results hold every radius the config allows (ceil(max + 1/2) voxels).
+static_assert(EsdfConfig::kMaxDistanceVoxels + 1 <= kEdtMaxRadius16,
+              "the ESDF's radius must fit the 16-bit distance transform");
+
 std::size_t volume(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi) {
   if ((hi.array() < lo.array()).any()) return 0;
   const Eigen::Vector3i n = hi - lo + Eigen::Vector3i::Ones();
@@ -314,18 +318,18 @@ void Esdf::computeRegion(const BlockBox& write_box,
     boundedSquaredDistances3d(labels_.data(), size, seed, radius_voxels_, &squared_, &edt_scratch_);
     for (const Eigen::Vector3i& key : write_blocks) {
       EsdfBlock& block = *blocks_.find(key)->second;
-      const std::int32_t* sq = squared_.data() + offsetOf(key);
+      const std::int16_t* sq = squared_.data() + offsetOf(key);
       int i = 0;
       for (int z = 0; z < kTsdfBlockSide; ++z) {
         for (int y = 0; y < kTsdfBlockSide; ++y) {
-          const std::int32_t* row = sq + y * nx + z * nxy;
+          const std::int16_t* row = sq + y * nx + z * nxy;
           for (int x = 0; x < kTsdfBlockSide; ++x, ++i) {
             const auto st = static_cast<EsdfState>(block.state[i]);
             if (st == EsdfState::kUnknown) {
               block.distance[i] = kNaN;
             } else if (st == target) {
-              block.distance[i] =
-                  esdfMetres(row[x], occupied, voxel_size_m_, config_.max_distance_m);
+              block.distance[i] = esdfMetres(row[x] == kEdtFarSquared16 ? kEdtFarSquared : row[x],
+                                             occupied, voxel_size_m_, config_.max_distance_m);
             }
           }
         }
@@ -381,8 +385,7 @@ EsdfSample Esdf::sample(const Eigen::Vector3d& p) const {
 std::size_t Esdf::memoryBytes() const {
   return blocks_.size() * sizeof(EsdfBlock) +
          blocks_.bucket_count() * (sizeof(Eigen::Vector3i) + sizeof(void*) + sizeof(std::int32_t)) +
-         labels_.capacity() +
-         (squared_.capacity() + edt_scratch_.capacity()) * sizeof(std::int32_t);
+         labels_.capacity() + squared_.capacity() * sizeof(std::int16_t) + edt_scratch_.bytes();
 }
 
 }  // namespace downstream_perception

@@ -155,7 +155,8 @@ EsdfBandSlice esdfBandSlice(const TsdfMap& map, const EsdfBandConfig& config) {
   // (negative) to the nearest free one; one layer, so the transform is the 2-D one.
   const int radius_voxels = static_cast<int>(
       std::min({radius, static_cast<double>(px) + py + 1, double{kMaxRadiusVoxels}}));
-  std::vector<std::int32_t> squared, scratch;
+  std::vector<std::int32_t> squared;
+  EdtScratch scratch;
   for (const EsdfState target_state : {EsdfState::kFree, EsdfState::kOccupied}) {
     const bool occupied = target_state == EsdfState::kOccupied;
     const std::size_t targets = occupied ? out.stats.columns_occupied : out.stats.columns_free;

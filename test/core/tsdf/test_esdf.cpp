@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "downstream_perception/core/tsdf/distance_transform_3d.h"
@@ -19,36 +20,78 @@
 using namespace downstream_perception;        // NOLINT
 using namespace downstream_perception::test;  // NOLINT
 
-TEST(DistanceTransform3d, MatchesBruteForceOnRandomSeeds) {
-  const Eigen::Vector3i size(23, 17, 13);
-  const int radius = 6;
-  std::mt19937 rng(7);
+// Radii on both sides of the transform's switch from the brute-force window (r <= 127) to the
+// lower envelope (32-bit results; the 16-bit ones, window only, must agree or refuse the radius),
+// on boxes longer than 2 r + 1 along some axis, with seeds sparse enough that planes and rows
+// without any are skipped.
+struct TransformCase {
+  Eigen::Vector3i size;
+  int radius;
+  int seed_one_in;
+};
+
+class DistanceTransform3dRadii : public ::testing::TestWithParam<TransformCase> {};
+
+TEST_P(DistanceTransform3dRadii, MatchesBruteForceOnRandomSeeds) {
+  const Eigen::Vector3i size = GetParam().size;
+  const int radius = GetParam().radius;
+  std::mt19937 rng(7 + radius);
   std::vector<std::uint8_t> labels(static_cast<std::size_t>(size.prod()));
-  for (auto& l : labels) l = static_cast<std::uint8_t>(rng() % 50 == 0 ? 2 : rng() % 3 == 0);
-  std::vector<std::int32_t> out, scratch;
+  for (auto& l : labels) {
+    l = static_cast<std::uint8_t>(rng() % GetParam().seed_one_in == 0 ? 2 : rng() % 3 == 0);
+  }
+  std::vector<std::int32_t> out;
+  std::vector<std::int16_t> out16;
+  EdtScratch scratch;
   boundedSquaredDistances3d(labels.data(), size, 2, radius, &out, &scratch);
   ASSERT_EQ(out.size(), labels.size());
-  std::size_t off = 0, within = 0;
+  const bool narrow = radius <= kEdtMaxRadius16;
+  if (narrow) {
+    boundedSquaredDistances3d(labels.data(), size, 2, radius, &out16, &scratch);
+    ASSERT_EQ(out16.size(), labels.size());
+  } else {
+    EXPECT_THROW(boundedSquaredDistances3d(labels.data(), size, 2, radius, &out16, &scratch),
+                 std::invalid_argument);
+  }
+  std::vector<Eigen::Vector3i> seeds;
+  for (int k = 0; k < size.prod(); ++k) {
+    if (labels[k] == 2) {
+      seeds.emplace_back(k % size.x(), k / size.x() % size.y(), k / (size.x() * size.y()));
+    }
+  }
+  std::size_t off = 0, within = 0, far = 0;
   for (int z = 0; z < size.z(); ++z) {
     for (int y = 0; y < size.y(); ++y) {
       for (int x = 0; x < size.x(); ++x) {
         std::int32_t best = kEdtFarSquared;
-        for (int k = 0; k < size.prod(); ++k) {
-          if (labels[k] != 2) continue;
-          const int dx = k % size.x() - x, dy = k / size.x() % size.y() - y,
-                    dz = k / (size.x() * size.y()) - z;
-          const int d2 = dx * dx + dy * dy + dz * dz;
+        for (const Eigen::Vector3i& s : seeds) {
+          const int d2 = (s - Eigen::Vector3i(x, y, z)).squaredNorm();
           if (d2 <= radius * radius) best = std::min(best, d2);
         }
-        const std::int32_t got = out[(z * size.y() + y) * size.x() + x];
-        off += got != best;
+        const int i = (z * size.y() + y) * size.x() + x;
+        off += out[i] != best;
+        if (narrow) off += out16[i] != (best == kEdtFarSquared ? kEdtFarSquared16 : best);
         within += best != kEdtFarSquared && best > 0;
+        far += best == kEdtFarSquared;
       }
     }
   }
   EXPECT_EQ(off, 0u);
-  EXPECT_GT(within, 1000u);  // the test sees real distances, not only seeds and "far"
+  // The test sees real distances, not only seeds and "far" (none within radius 0), and, with
+  // sparse seeds, voxels out of reach.
+  if (radius > 0) EXPECT_GT(within, 1000u);
+  if (radius == 0) EXPECT_EQ(within, 0u);
+  if (GetParam().seed_one_in > 100) EXPECT_GT(far, 500u);
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    WindowAndEnvelope, DistanceTransform3dRadii,
+    ::testing::Values(TransformCase{{23, 17, 13}, 6, 50},     // window, dense seeds
+                      TransformCase{{181, 9, 11}, 40, 8000},  // window, sparse seeds
+                      TransformCase{{401, 5, 5}, 127, 8000},  // window at its largest radius
+                      TransformCase{{401, 5, 5}, 128, 8000},  // envelope just beyond it
+                      TransformCase{{9, 11, 83}, 5, 300},     // window, sparse: rows skipped
+                      TransformCase{{23, 17, 13}, 0, 50}));   // radius 0: seeds only
 
 class EsdfRoomOffsets : public ::testing::TestWithParam<Eigen::Vector3d> {};
 

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "downstream_perception/core/tsdf/distance_transform_3d.h"
 #include "downstream_perception/core/tsdf/tsdf_map.h"
 
 namespace downstream_perception {
@@ -136,8 +137,8 @@ class Esdf {
   bool full_next_ = true;
   // Scratch of the distance transform, kept between updates.
   std::vector<std::uint8_t> labels_;
-  std::vector<std::int32_t> squared_;
-  std::vector<std::int32_t> edt_scratch_;
+  std::vector<std::int16_t> squared_;  // radius_voxels_ <= kEdtMaxRadius16
+  EdtScratch edt_scratch_;
 };
 
 }  // namespace downstream_perception
