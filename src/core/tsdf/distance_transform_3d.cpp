@@ -267,6 +267,17 @@ void envelopeTransform(const std::uint8_t* labels, int nx, int ny, int nz, std::
   }
 }
 
+/// Resizes `out` to the box of `size` voxels; false (and `out` empty) for an empty box.
+template <typename T>
+bool fitToBox(const Eigen::Vector3i& size, std::vector<T>* out) {
+  if ((size.array() <= 0).any()) {
+    out->clear();
+    return false;
+  }
+  out->resize(static_cast<std::size_t>(size.x()) * size.y() * size.z());
+  return true;
+}
+
 }  // namespace
 
 std::size_t EdtScratch::bytes() const {
@@ -274,27 +285,23 @@ std::size_t EdtScratch::bytes() const {
          (narrow.capacity() + narrow_plane.capacity() + narrow_row.capacity()) * sizeof(Narrow);
 }
 
+// Pass 1 (z) by running counts along the columns, swept plane by plane so memory is read in
+// order; passes 2 (y) and 3 (x) by a brute-force window over the 2 r + 1 neighbours in 16 bits
+// up to kWindowMaxRadius, by the lower envelope beyond. Either way a line (or plane) that is all
+// seeds (0) or has no seed within reach stays as it is: with dense seeds (free space, for the
+// distances of occupied voxels) most are skipped.
 void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i& size,
                                std::uint8_t seed_label, int max_distance_voxels,
                                std::vector<std::int32_t>* out, EdtScratch* scratch) {
-  const int nx = size.x(), ny = size.y(), nz = size.z();
-  if (nx <= 0 || ny <= 0 || nz <= 0) {
-    out->clear();
-    return;
-  }
-  out->resize(static_cast<std::size_t>(nx) * ny * nz);
-  // Pass 1 (z) by running counts along the columns, swept plane by plane so memory is read in
-  // order; passes 2 (y) and 3 (x) by a brute-force window over the 2 r + 1 neighbours in 16
-  // bits up to kWindowMaxRadius, by the lower envelope beyond. Either way a line (or plane)
-  // that is all seeds (0) or has no seed within reach stays as it is: with dense seeds (free
-  // space, for the distances of occupied voxels) most are skipped.
+  if (!fitToBox(size, out)) return;
   const int r = std::max(0, max_distance_voxels);
   if (r > kWindowMaxRadius) {
-    envelopeTransform(labels, nx, ny, nz, seed_label, r, out->data(), scratch);
+    envelopeTransform(labels, size.x(), size.y(), size.z(), seed_label, r, out->data(), scratch);
     return;
   }
   scratch->narrow.resize(out->size());
-  windowTransform(labels, nx, ny, nz, seed_label, r, scratch->narrow.data(), scratch);
+  windowTransform(labels, size.x(), size.y(), size.z(), seed_label, r, scratch->narrow.data(),
+                  scratch);
   detail::widen(scratch->narrow.data(), out->size(), static_cast<Narrow>(r * r), out->data());
 }
 
@@ -302,19 +309,14 @@ void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i
                                std::uint8_t seed_label, int max_distance_voxels,
                                std::vector<std::int16_t>* out, EdtScratch* scratch) {
   if (max_distance_voxels > kEdtMaxRadius16) {
+    const std::string limit = std::to_string(kEdtMaxRadius16);
     throw std::invalid_argument(
-        "boundedSquaredDistances3d: 16-bit results need a radius of at "
-        "most " +
-        std::to_string(kEdtMaxRadius16) + " voxels, got " + std::to_string(max_distance_voxels));
+        "boundedSquaredDistances3d: 16-bit results need a radius of at most " + limit +
+        " voxels, got " + std::to_string(max_distance_voxels));
   }
-  const int nx = size.x(), ny = size.y(), nz = size.z();
-  if (nx <= 0 || ny <= 0 || nz <= 0) {
-    out->clear();
-    return;
-  }
-  out->resize(static_cast<std::size_t>(nx) * ny * nz);
+  if (!fitToBox(size, out)) return;
   const int r = std::max(0, max_distance_voxels);
-  windowTransform(labels, nx, ny, nz, seed_label, r, out->data(), scratch);
+  windowTransform(labels, size.x(), size.y(), size.z(), seed_label, r, out->data(), scratch);
   detail::markFar(out->size(), static_cast<Narrow>(r * r), out->data());
 }
 
