@@ -81,8 +81,9 @@ namespace detail {
 /// Pass 1: squared distance along z (nz planes of `plane` voxels) to the nearest voxel labelled
 /// `seed` in the same column; `far_squared` from `far` voxels on. `run` holds a plane.
 template <typename T>
-void columnPass(const std::uint8_t* labels, std::size_t plane, int nz, std::uint8_t seed, T far,
-                T far_squared, T* run, T* out) {
+[[gnu::always_inline]] inline void columnPass(const std::uint8_t* labels, std::size_t plane, int nz,
+                                              std::uint8_t seed, T far, T far_squared, T* run,
+                                              T* out) {
   std::fill(run, run + plane, far);
   for (int z = 0; z < nz; ++z) {
     const std::uint8_t* l = labels + plane * z;
@@ -119,7 +120,7 @@ void columnPassNarrow(const std::uint8_t* labels, std::size_t plane, int nz, std
 /// Whether the n values hold a seed within reach (<= cap2) and a non-seed (> 0): else a pass
 /// leaves them as they are.
 template <typename T>
-bool needsPass(const T* v, std::size_t n, T cap2) {
+[[gnu::always_inline]] inline bool needsPass(const T* v, std::size_t n, T cap2) {
   T lo = std::numeric_limits<T>::max(), hi = 0;
   for (std::size_t i = 0; i < n; ++i) {
     lo = std::min(lo, v[i]);
@@ -138,32 +139,44 @@ bool needsPassNarrow(const Narrow* v, std::size_t n, Narrow cap2) {
   return needsPass(v, n, cap2);
 }
 
+/// Row width of the y pass's input: whole chunks.
+constexpr int kAcrossChunk = 32;
+
 /// The y pass within radius r, by brute force over the 2 r + 1 rows around each row: row y of
-/// `out` = min over |k| <= r of row y + k of `in` (a z plane, nx x ny) + k^2, above cap2
-/// `far_squared`. A row whose smallest value + k^2 exceeds cap2 cannot lower anything (the
-/// result would be capped): skipped, which in sparse regions is most of them. `row_min` holds
-/// ny values.
+/// `out` (nx wide) = min over |k| <= r of row y + k of `in` (a z plane of ny rows, `stride` a
+/// multiple of kAcrossChunk wide, padded with far_squared) + k^2, above cap2 `far_squared`. A row
+/// whose smallest value + k^2 exceeds cap2 cannot lower anything (the result would be capped):
+/// skipped, which in sparse regions is most of them. `row_min` holds ny values.
 DP_AVX2_CLONES
-void windowPassAcrossRows(const Narrow* in, int nx, int ny, int r, Narrow cap2, Narrow far_squared,
-                          Narrow* row_min, Narrow* out) {
+void windowPassAcrossRows(const Narrow* in, int stride, int nx, int ny, int r, Narrow cap2,
+                          Narrow far_squared, Narrow* row_min, Narrow* out) {
   for (int y = 0; y < ny; ++y) {
-    const Narrow* row = in + static_cast<std::size_t>(y) * nx;
+    const Narrow* row = in + static_cast<std::size_t>(y) * stride;
     Narrow lo = far_squared;
-    for (int x = 0; x < nx; ++x) lo = std::min(lo, row[x]);
+    for (int x = 0; x < stride; ++x) lo = std::min(lo, row[x]);
     row_min[y] = lo;
   }
+  // A chunk of a row at a time, its minima held in registers across the 2 r taps (a whole row
+  // would be loaded and stored again at every tap).
   for (int y = 0; y < ny; ++y) {
-    Narrow* o = out + static_cast<std::size_t>(y) * nx;
-    std::copy(in + static_cast<std::size_t>(y) * nx, in + static_cast<std::size_t>(y + 1) * nx, o);
-    for (int k = 1; k <= r; ++k) {
-      const auto kk = static_cast<Narrow>(k * k);
-      for (const int source : {y - k, y + k}) {
-        if (source < 0 || source >= ny || row_min[source] > cap2 - kk) continue;
-        const Narrow* a = in + static_cast<std::size_t>(source) * nx;
-        for (int x = 0; x < nx; ++x) o[x] = std::min(o[x], static_cast<Narrow>(a[x] + kk));
+    for (int x0 = 0; x0 < nx; x0 += kAcrossChunk) {
+      Narrow acc[kAcrossChunk];
+      const Narrow* centre = in + static_cast<std::size_t>(y) * stride + x0;
+      for (int i = 0; i < kAcrossChunk; ++i) acc[i] = centre[i];
+      for (int k = 1; k <= r; ++k) {
+        const auto kk = static_cast<Narrow>(k * k);
+        for (const int source : {y - k, y + k}) {
+          if (source < 0 || source >= ny || row_min[source] > cap2 - kk) continue;
+          const Narrow* a = in + static_cast<std::size_t>(source) * stride + x0;
+          for (int i = 0; i < kAcrossChunk; ++i) {
+            acc[i] = std::min(acc[i], static_cast<Narrow>(a[i] + kk));
+          }
+        }
       }
+      Narrow* o = out + static_cast<std::size_t>(y) * nx + x0;
+      const int n = std::min(kAcrossChunk, nx - x0);
+      for (int i = 0; i < n; ++i) o[i] = acc[i] > cap2 ? far_squared : acc[i];
     }
-    for (int x = 0; x < nx; ++x) o[x] = o[x] > cap2 ? far_squared : o[x];
   }
 }
 
@@ -215,12 +228,18 @@ void windowTransform(const std::uint8_t* labels, int nx, int ny, int nz, std::ui
   scratch->narrow_row.resize(
       std::max(static_cast<std::size_t>(ny),
                static_cast<std::size_t>(nx) + 2 * static_cast<std::size_t>(r)));
-  // Pass 2 (y): each z plane (it stays in cache), from a copy.
+  // Pass 2 (y): each z plane (it stays in cache), from a copy whose rows are padded to whole
+  // chunks.
+  const int stride = (nx + detail::kAcrossChunk - 1) / detail::kAcrossChunk * detail::kAcrossChunk;
+  scratch->narrow_plane.assign(static_cast<std::size_t>(stride) * ny, far_squared);
   for (int z = 0; z < nz; ++z) {
     Narrow* oz = narrow + plane * z;
     if (!detail::needsPassNarrow(oz, plane, cap2)) continue;
-    std::copy(oz, oz + plane, scratch->narrow_plane.begin());
-    detail::windowPassAcrossRows(scratch->narrow_plane.data(), nx, ny, r, cap2, far_squared,
+    for (int y = 0; y < ny; ++y) {
+      std::copy(oz + static_cast<std::size_t>(y) * nx, oz + static_cast<std::size_t>(y + 1) * nx,
+                scratch->narrow_plane.begin() + static_cast<std::ptrdiff_t>(y) * stride);
+    }
+    detail::windowPassAcrossRows(scratch->narrow_plane.data(), stride, nx, ny, r, cap2, far_squared,
                                  scratch->narrow_row.data(), oz);
   }
   // Pass 3 (x): each row, from a copy padded with far values.
