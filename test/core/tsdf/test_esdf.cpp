@@ -20,10 +20,10 @@
 using namespace downstream_perception;        // NOLINT
 using namespace downstream_perception::test;  // NOLINT
 
-// Radii on both sides of the transform's switch from the brute-force window (r <= 127) to the
-// lower envelope (32-bit results; the 16-bit ones, window only, must agree or refuse the radius),
-// on boxes longer than 2 r + 1 along some axis, with seeds sparse enough that planes and rows
-// without any are skipped.
+// Radii on both sides of the transform's switches from the brute-force window to the lower
+// envelope (32-bit results: window up to r = 64; 16-bit results: window only, up to 127, a larger
+// radius refused), on boxes longer than 2 r + 1 along some axis, with seeds sparse enough that
+// planes and rows without any are skipped.
 struct TransformCase {
   Eigen::Vector3i size;
   int radius;
@@ -88,8 +88,10 @@ INSTANTIATE_TEST_SUITE_P(
     WindowAndEnvelope, DistanceTransform3dRadii,
     ::testing::Values(TransformCase{{23, 17, 13}, 6, 50},     // window, dense seeds
                       TransformCase{{181, 9, 11}, 40, 8000},  // window, sparse seeds
-                      TransformCase{{401, 5, 5}, 127, 8000},  // window at its largest radius
-                      TransformCase{{401, 5, 5}, 128, 8000},  // envelope just beyond it
+                      TransformCase{{181, 9, 11}, 64, 8000},  // 32-bit window at its largest
+                      TransformCase{{181, 9, 11}, 65, 8000},  // 32-bit envelope
+                      TransformCase{{401, 5, 5}, 127, 8000},  // 16-bit window at its largest
+                      TransformCase{{401, 5, 5}, 128, 8000},  // envelope only
                       TransformCase{{9, 11, 83}, 5, 300},     // window, sparse: rows skipped
                       TransformCase{{23, 17, 13}, 0, 50}));   // radius 0: seeds only
 

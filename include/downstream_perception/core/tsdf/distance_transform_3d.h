@@ -1,8 +1,8 @@
 // Exact 3-D Euclidean distance transform of a dense box, bounded to a radius, separable on
 // integer squared distances (the 3-D form of the inflation layer's boundedSquaredDistances):
 // along z by running counts, then along y and x by a brute-force window over the 2 r + 1
-// neighbours of each voxel for radii r up to 127 voxels (16-bit, rows at a time, so it
-// vectorises), or by
+// neighbours of each voxel (in 16 bits, rows at a time, so it vectorises) for radii r up to 127
+// voxels (16-bit results) or 64 (32-bit results), or by
 // the lower envelope of parabolas of Felzenszwalb & Huttenlocher ("Distance Transforms of
 // Sampled Functions", 2012) beyond. Exact either way: every result is the squared distance to
 // the nearest seed voxel (no wavefront approximation), in integers.
