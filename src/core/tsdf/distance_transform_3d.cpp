@@ -12,19 +12,17 @@ namespace downstream_perception {
 
 namespace {
 
-/// Radii (voxels) up to which passes 2 and 3 use the brute-force window in 16-bit integers: a
-/// squared distance within reach plus a window's k^2 stays below 2 r^2 + 2, which fits up to
-/// r = 127. The window's cost grows with r (2 r + 1 taps per voxel), the envelope's does not,
-/// but 16 lanes a vector win in 3-D throughout: on the room's ESDF updates (one thread) 2.9x
-/// faster than the envelope at r = 21, 1.2x at r = 101, the ESDF's largest.
-constexpr int kWindowMaxRadius = kEdtMaxRadius16;
-/// For 32-bit results, which only the band ESDF's 2-D transform asks for, measured there (the
-/// room's band at 2 cm against the envelope): 7 % faster at r = 40, even at 64, 10 % slower at
-/// 100.
-constexpr int kWindowMaxRadius32 = 64;
-static_assert(2 * kWindowMaxRadius * kWindowMaxRadius + 1 <=
-                  std::numeric_limits<std::int16_t>::max(),
+// Passes 2 and 3 by the brute-force window run in 16-bit integers: a squared distance within
+// reach plus a window's k^2 stays below 2 r^2 + 2, which fits up to r = kEdtMaxRadius16. The
+// window's cost grows with r (2 r + 1 taps per voxel), the envelope's does not, but 16 lanes a
+// vector win in 3-D throughout: on the room's ESDF updates (one thread) 2.9x faster than the
+// envelope at r = 21, 1.2x at r = 101, the ESDF's largest.
+static_assert(2 * kEdtMaxRadius16 * kEdtMaxRadius16 + 1 <= std::numeric_limits<std::int16_t>::max(),
               "the window's sums must fit 16 bits");
+/// Radii up to which 32-bit results, which only the band ESDF's 2-D transform asks for, take the
+/// window, measured there (the room's band at 2 cm against the envelope): 7 % faster at r = 40,
+/// even at 64, 10 % slower at 100.
+constexpr int kWindowMaxRadius32 = 64;
 
 using Narrow = std::int16_t;
 
@@ -218,14 +216,14 @@ void markFar(std::size_t n, Narrow cap2, Narrow* v) {
 
 namespace {
 
-/// All three passes in 16 bits (r <= kWindowMaxRadius), passes 2 and 3 by the window, in
+/// All three passes in 16 bits (r <= kEdtMaxRadius16), passes 2 and 3 by the window, in
 /// `narrow` (the box's voxels): squared distances up to cap2 = r^2, r^2 + 1 beyond.
 void windowTransform(const std::uint8_t* labels, int nx, int ny, int nz, std::uint8_t seed_label,
                      int r, Narrow* narrow, EdtScratch* scratch) {
   const std::size_t plane = static_cast<std::size_t>(nx) * ny;
   const auto cap2 = static_cast<Narrow>(r * r);
   const auto far_squared = static_cast<Narrow>(r * r + 1);
-  scratch->narrow_plane.resize(plane);
+  scratch->narrow_plane.resize(plane);  // pass 1's running counts, then pass 2's input
   detail::columnPassNarrow(labels, plane, nz, seed_label, static_cast<Narrow>(r + 1), far_squared,
                            scratch->narrow_plane.data(), narrow);
   // narrow_row: the y pass's row minima (ny), then the x pass's padded row (nx + 2 r).
@@ -310,10 +308,10 @@ std::size_t EdtScratch::bytes() const {
 
 // Pass 1 (z) by running counts along the columns, swept plane by plane so memory is read in
 // order; passes 2 (y) and 3 (x) by a brute-force window over the 2 r + 1 neighbours in 16 bits
-// up to kWindowMaxRadius32 (32-bit results) or kWindowMaxRadius (16-bit), by the lower envelope
-// beyond. Either way a line (or plane) that is all
-// seeds (0) or has no seed within reach stays as it is: with dense seeds (free space, for the
-// distances of occupied voxels) most are skipped.
+// up to kWindowMaxRadius32 (32-bit results) or kEdtMaxRadius16 (16-bit), by the lower envelope
+// beyond. Either way a line (or plane) that is all seeds (0) or has no seed within reach stays
+// as it is: with dense seeds (free space, for the distances of occupied voxels) most are
+// skipped.
 void boundedSquaredDistances3d(const std::uint8_t* labels, const Eigen::Vector3i& size,
                                std::uint8_t seed_label, int max_distance_voxels,
                                std::vector<std::int32_t>* out, EdtScratch* scratch) {

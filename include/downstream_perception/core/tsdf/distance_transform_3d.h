@@ -2,10 +2,10 @@
 // integer squared distances (the 3-D form of the inflation layer's boundedSquaredDistances):
 // along z by running counts, then along y and x by a brute-force window over the 2 r + 1
 // neighbours of each voxel (in 16 bits, rows at a time, so it vectorises) for radii r up to 127
-// voxels (16-bit results) or 64 (32-bit results), or by
-// the lower envelope of parabolas of Felzenszwalb & Huttenlocher ("Distance Transforms of
-// Sampled Functions", 2012) beyond. Exact either way: every result is the squared distance to
-// the nearest seed voxel (no wavefront approximation), in integers.
+// voxels (16-bit results) or 64 (32-bit results), beyond by the lower envelope of parabolas of
+// Felzenszwalb & Huttenlocher ("Distance Transforms of Sampled Functions", 2012). Exact either
+// way: every result is the squared distance to the nearest seed voxel (no wavefront
+// approximation), in integers.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,8 +23,8 @@ constexpr std::int16_t kEdtFarSquared16 = 0x7fff;
 /// Largest radius (voxels) of 16-bit results: a squared distance plus a window's k^2 fits.
 constexpr int kEdtMaxRadius16 = 127;
 
-/// Buffers boundedSquaredDistances3d keeps between calls (no allocation once grown): a plane,
-/// and for 32-bit results within kEdtMaxRadius16 2 bytes per voxel of the largest box.
+/// Buffers boundedSquaredDistances3d keeps between calls (no allocation once grown): about a
+/// plane, and for 32-bit results the window computes 2 bytes per voxel of the largest box.
 struct EdtScratch {
   std::vector<std::int32_t> run;
   std::vector<std::int16_t> narrow, narrow_plane, narrow_row;
