@@ -554,6 +554,13 @@ class TsdfConfig:
     @max_weight.setter
     def max_weight(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
+    def mesh_extrapolate_voxels(self) -> float:
+        """
+        Marching cubes fills a missing voxel (unobserved, not unconfirmed) next to the surface by linear extrapolation along a lattice axis from the two observed voxels before it, the nearer within this many voxels of the surface (keeping its sign), so the mesh reaches a surface's edge where the voxel beyond was not written. Mesh only. 0 = off.
+        """
+    @mesh_extrapolate_voxels.setter
+    def mesh_extrapolate_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
     def min_depth_m(self) -> float:
         """
         closer depths are invalid
@@ -752,7 +759,7 @@ class Tsdf:
         """
     def update_mesh(self) -> int:
         """
-        Re-extracts the blocks changed since the last call; returns how many.
+        Re-extracts the blocks changed since the last call (every block after a change of min_weight or mesh_extrapolate_voxels); returns how many.
         """
     def write_ply(self, path: str) -> None:
         """

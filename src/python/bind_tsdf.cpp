@@ -305,6 +305,12 @@ void bindTsdf(py::module& m) {
           "min_weight", &TsdfConfig::min_weight,
           "Voxels whose weight is below this are \"unobserved\" for meshing and queries.")
       .def_readwrite(
+          "mesh_extrapolate_voxels", &TsdfConfig::mesh_extrapolate_voxels,
+          "Marching cubes fills a missing voxel (unobserved, not unconfirmed) next to the surface "
+          "by linear extrapolation along a lattice axis from the two observed voxels before it, "
+          "the nearer within this many voxels of the surface (keeping its sign), so the mesh "
+          "reaches a surface's edge where the voxel beyond was not written. Mesh only. 0 = off.")
+      .def_readwrite(
           "max_blocks", &TsdfConfig::max_blocks,
           "Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig) "
           "evicts blocks down to the new cap at once: the least recently updated first, among "
@@ -423,7 +429,8 @@ void bindTsdf(py::module& m) {
           "Signed distance (m, NaN where unobserved) and weight of the voxel nearest each point.")
       .def(
           "update_mesh", [](Tsdf& self) { return self.mesher.update(self.map); },
-          "Re-extracts the blocks changed since the last call; returns how many.")
+          "Re-extracts the blocks changed since the last call (every block after a change of "
+          "min_weight or mesh_extrapolate_voxels); returns how many.")
       .def(
           "mesh", [](const Tsdf& self) { return meshToDict(self.mesher.combined()); },
           "The mesh as of the last update_mesh(): dict of vertices (V, 3) float32 m, normals "

@@ -130,20 +130,141 @@ std::vector<std::array<int, 3>> deriveCase(int mask) {
   return triangles;
 }
 
-// The block's cube corners (lattice 0 .. 8 per axis) plus the border their gradients read
-// (-1 and 9): the distances gathered from the 27 blocks around it once, NaN where a voxel is
-// missing or lighter than min_weight, so the loops read one small array.
-constexpr int kPad = kTsdfBlockSide + 3;
+// The block's cube corners (lattice 0 .. 8 per axis), the border their gradients read (-1 and
+// 9) and, when missing voxels are extrapolated, the two voxels beyond it that extrapolation
+// reads (-3 .. 11): the distances gathered from the 27 blocks around it once, NaN where a voxel
+// is missing or lighter than min_weight, so the loops read one small array.
+// Without extrapolation the margin is one voxel: the smaller array kept the extraction 10 %
+// faster than one laid out for both (measured on the room at 2 cm).
+template <int Margin>
 struct Neighbourhood {
+  static constexpr int kPad = kTsdfBlockSide + 1 + 2 * Margin;
   std::array<float, kPad * kPad * kPad> distance;
-  static int at(int x, int y, int z) { return (x + 1) + kPad * ((y + 1) + kPad * (z + 1)); }
+  static int at(int x, int y, int z) {
+    return (x + Margin) + kPad * ((y + Margin) + kPad * (z + Margin));
+  }
   float operator()(int x, int y, int z) const { return distance[at(x, y, z)]; }
 };
+constexpr int kExtrapolationMargin = 3;
+using Extrapolated = Neighbourhood<kExtrapolationMargin>;
+
+// Observed: not NaN.
+bool isObserved(float d) {
+  return d == d;
+}
+// Missing voxels are NaN; an unconfirmed one (TsdfConfig::confirm_depth_voxels: the mesh leaves
+// it out) is the NaN with the sign bit set, so the extrapolation, the only reader that tells
+// the two apart, does not fill it.
+const float kMissing = std::numeric_limits<float>::quiet_NaN();
+const float kUnconfirmed = -std::numeric_limits<float>::quiet_NaN();
+bool isUnconfirmed(float d) {
+  return !isObserved(d) && std::signbit(d);
+}
+
+// The extrapolation's bounds (TsdfConfig::mesh_extrapolate_voxels), in normalised distance D
+// (one voxel = 1 / truncation_voxels).
+struct Extrapolation {
+  float near;   ///< |D1| of the observed voxel next to the missing one, at most
+  float voxel;  ///< one voxel
+};
+
+/// Fills each missing voxel of the cube corners and their border (-1 .. 9) that is not
+/// unconfirmed with 2 D1 - D2, D1 and D2 the two observed voxels before it along a lattice axis
+/// (D1 the nearer), where
+/// - D1 lies within `near` of the surface and D2 inside the band (|D2| < 1);
+/// - along the surface, the two agree within a quarter voxel: the value keeps D1's sign and
+///   continues the surface sideways (the edge the guard withheld). Measured: half a voxel let a
+///   far floor's projective ramp, seen at grazing, run on one voxel under the floor;
+/// - across it, they step by 0.9 to 1.2 voxels (a distance field's slope, one voxel per voxel
+///   along the normal, within rounding and fusion's noise):
+///   the value changes sign, a surface just beyond the observed voxels. Other steps fill
+///   nothing (under depth noise, D1 - D2 along a wall is noise, and doubling it
+///   flipped signs behind walls);
+/// - no observed neighbour of the opposite sign lies a whole band (|D| ~ 1) from any surface:
+///   a crossing between the two would be a jump, not a surface.
+/// Where several axes qualify, their mean, unless their signs differ (then it stays missing).
+/// Reads only observed voxels, so a filled voxel is the same in every block that reads it.
+void extrapolate(const Extrapolation& e, Extrapolated* n) {
+  constexpr int kPad = Extrapolated::kPad;
+  constexpr float kAlongSurface = 0.25f, kAcrossMin = 0.9f, kAcrossMax = 1.2f, kWholeBand = 0.99f;
+  constexpr std::array<int, 6> kNeighbours = {1, -1, kPad, -kPad, kPad * kPad, -kPad * kPad};
+  const Extrapolated& source = *n;
+  auto filled = n->distance;
+  for (int z = -1; z <= kTsdfBlockSide + 1; ++z) {
+    for (int y = -1; y <= kTsdfBlockSide + 1; ++y) {
+      for (int x = -1; x <= kTsdfBlockSide + 1; ++x) {
+        const int i = Extrapolated::at(x, y, z);
+        const float d0 = source.distance[i];
+        if (isObserved(d0) || isUnconfirmed(d0)) continue;
+        float sum = 0.0f;
+        int count = 0, negative = 0;
+        for (const int q : kNeighbours) {
+          const float d1 = source.distance[i + q];
+          const float d2 = source.distance[i + 2 * q];
+          const float step = std::abs(d1 - d2);  // NaN fails every comparison below
+          if (!(std::abs(d1) <= e.near && std::abs(d2) < 1.0f)) continue;
+          const float value = 2.0f * d1 - d2;
+          const bool flips = (value < 0.0f) != (d1 < 0.0f);
+          const bool along = !flips && step <= kAlongSurface * e.voxel;
+          const bool across = flips && step >= kAcrossMin * e.voxel && step <= kAcrossMax * e.voxel;
+          if (!(along || across)) continue;
+          sum += value;
+          ++count;
+          negative += value < 0.0f;
+        }
+        if (count == 0 || (negative != 0 && negative != count)) continue;
+        const float value = sum / static_cast<float>(count);
+        bool jump = false;
+        for (const int q : kNeighbours) {
+          const float d = source.distance[i + q];
+          jump |= isObserved(d) && (d < 0.0f) != (value < 0.0f) && std::abs(d) > kWholeBand;
+        }
+        if (!jump) filled[i] = value;
+      }
+    }
+  }
+  n->distance = filled;
+}
+
+/// Whether a cube of the block (corners at lattice 0 .. 8) holds both a negative and a
+/// non-negative distance.
+template <int Margin>
+bool holdsSurface(const Neighbourhood<Margin>& n) {
+  bool negative = false, non_negative = false;
+  for (int z = 0; z <= kTsdfBlockSide; ++z) {
+    for (int y = 0; y <= kTsdfBlockSide; ++y) {
+      const float* row = &n.distance[Neighbourhood<Margin>::at(0, y, z)];
+      for (int x = 0; x <= kTsdfBlockSide; ++x) {
+        negative |= row[x] < 0.0f;
+        non_negative |= row[x] >= 0.0f;  // NaN is neither
+      }
+    }
+  }
+  return negative && non_negative;
+}
+
+/// Whether extrapolation could give the block's corners a surface: they or the voxels it reads
+/// hold both signs, or a value within `near` of zero (every fill reads one, so without it the
+/// block, seen only far in front of or behind surfaces, stays as gathered).
+bool mayHoldSurface(const Extrapolated& n, float near) {
+  bool negative = false, non_negative = false;
+  for (std::size_t i = 0; i < n.distance.size(); ++i) {
+    const float d = n.distance[i];
+    if (std::abs(d) <= near) return true;
+    negative |= d < 0.0f;
+    non_negative |= d >= 0.0f;
+  }
+  return negative && non_negative;
+}
 
 /// Fills n; returns whether a cube of the block can hold a surface: its corners (lattice
-/// 0 .. 8) hold both a negative and a non-negative observed distance. About 40 % of the blocks
-/// of a typical map hold none (free space in front of the surface, or inside).
-bool gather(const TsdfMap& map, const Eigen::Vector3i& block, float min_weight, Neighbourhood* n) {
+/// 0 .. 8) hold both a negative and a non-negative distance, observed or extrapolated. About
+/// 40 % of the blocks of a typical map hold none (free space in front of the surface, or
+/// inside).
+template <int Margin>
+bool gather(const TsdfMap& map, const Eigen::Vector3i& block, Neighbourhood<Margin>* n) {
+  const TsdfConfig& config = map.config();
+  const auto min_weight = static_cast<float>(config.min_weight);
   std::array<const TsdfBlock*, 27> around{};
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
@@ -157,48 +278,47 @@ bool gather(const TsdfMap& map, const Eigen::Vector3i& block, float min_weight, 
     *offset = a < 0 ? -1 : (a >= kTsdfBlockSide ? 1 : 0);
     *local = a - *offset * kTsdfBlockSide;
   };
-  const float missing = std::numeric_limits<float>::quiet_NaN();
-  const auto observedDistance = [&](const TsdfBlock* b, int x, int y, int z) {
-    if (b == nullptr) return missing;
-    const TsdfVoxel& v = b->voxels[TsdfBlock::linear(x, y, z)];
-    // An unconfirmed voxel (TsdfConfig::confirm_depth_voxels) has a negative weight: missing.
-    return v.weight > min_weight ? v.distance : missing;
+  // An unconfirmed voxel has a negative weight.
+  const auto gathered = [min_weight](const TsdfVoxel& v) {
+    if constexpr (Margin == kExtrapolationMargin) {
+      return v.weight > min_weight ? v.distance : (v.weight < 0.0f ? kUnconfirmed : kMissing);
+    } else {
+      return v.weight > min_weight ? v.distance : kMissing;
+    }
   };
-  // Row by row (x = -1 .. 9): one voxel from the block on the left, the centre block's eight
-  // (a plain loop the compiler vectorises), two from the block on the right.
-  for (int z = -1; z <= kTsdfBlockSide + 1; ++z) {
+  const int first = -Margin, last = kTsdfBlockSide + Margin;
+  // Row by row: the voxels from the block on the left, the centre block's eight (a plain loop
+  // the compiler vectorises), those from the block on the right.
+  for (int z = first; z <= last; ++z) {
     int oz, lz;
     split(z, &oz, &lz);
-    for (int y = -1; y <= kTsdfBlockSide + 1; ++y) {
+    for (int y = first; y <= last; ++y) {
       int oy, ly;
       split(y, &oy, &ly);
       const int row_blocks = 3 * ((oy + 1) + 3 * (oz + 1));
-      float* out = &n->distance[Neighbourhood::at(-1, y, z)];
-      out[0] = observedDistance(around[row_blocks], kTsdfBlockSide - 1, ly, lz);
+      float* out = &n->distance[Neighbourhood<Margin>::at(0, y, z)];
+      for (int x = first; x <= last; ++x) {
+        if (x == 0) x = kTsdfBlockSide;
+        const TsdfBlock* b = around[row_blocks + (x < 0 ? 0 : 2)];
+        const int lx = x < 0 ? x + kTsdfBlockSide : x - kTsdfBlockSide;
+        out[x] = b == nullptr ? kMissing : gathered(b->voxels[TsdfBlock::linear(lx, ly, lz)]);
+      }
       const TsdfBlock* centre = around[row_blocks + 1];
       if (centre != nullptr) {
         const TsdfVoxel* v = &centre->voxels[TsdfBlock::linear(0, ly, lz)];
-        for (int x = 0; x < kTsdfBlockSide; ++x) {
-          out[1 + x] = v[x].weight > min_weight ? v[x].distance : missing;
-        }
+        for (int x = 0; x < kTsdfBlockSide; ++x) out[x] = gathered(v[x]);
       } else {
-        std::fill(out + 1, out + 1 + kTsdfBlockSide, missing);
-      }
-      out[kTsdfBlockSide + 1] = observedDistance(around[row_blocks + 2], 0, ly, lz);
-      out[kTsdfBlockSide + 2] = observedDistance(around[row_blocks + 2], 1, ly, lz);
-    }
-  }
-  bool negative = false, non_negative = false;
-  for (int z = 0; z <= kTsdfBlockSide; ++z) {
-    for (int y = 0; y <= kTsdfBlockSide; ++y) {
-      const float* row = &n->distance[Neighbourhood::at(0, y, z)];
-      for (int x = 0; x <= kTsdfBlockSide; ++x) {
-        negative |= row[x] < 0.0f;
-        non_negative |= row[x] >= 0.0f;  // NaN is neither
+        std::fill(out, out + kTsdfBlockSide, kMissing);
       }
     }
   }
-  return negative && non_negative;
+  if constexpr (Margin == kExtrapolationMargin) {
+    const auto voxel = static_cast<float>(1.0 / config.truncation_voxels);  // in D
+    const Extrapolation e{static_cast<float>(config.mesh_extrapolate_voxels) * voxel, voxel};
+    if (!mayHoldSurface(*n, e.near)) return false;
+    extrapolate(e, n);
+  }
+  return holdsSurface(*n);
 }
 
 bool hasZeroArea(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& ids) {
@@ -270,12 +390,16 @@ void TriangleMesh::writePly(std::ostream& out) const {
   }
 }
 
-TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) {
+namespace {
+
+template <int Margin>
+TriangleMesh extractBlockMeshWith(const TsdfMap& map, const Eigen::Vector3i& block) {
+  using Gathered = Neighbourhood<Margin>;
   TriangleMesh mesh;
-  Neighbourhood n;
+  Gathered n;
   // A block without a surface is done after the gather.
-  if (!gather(map, block, static_cast<float>(map.config().min_weight), &n)) return mesh;
-  const auto observed = [](float d) { return d == d; };  // not NaN
+  if (!gather(map, block, &n)) return mesh;
+  const auto observed = isObserved;
   // Gradient of D (per voxel) by central differences, one-sided where a neighbour is missing.
   const auto gradient = [&](int x, int y, int z) {
     Eigen::Vector3f g = Eigen::Vector3f::Zero();
@@ -310,10 +434,10 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
       // The row's eight cubes classified at once (a plain loop the compiler vectorises): the
       // inside mask of their corners (bit c: corner c negative), or 0 when a corner is
       // unobserved. Corner c of cube x lies in row (y + o[1], z + o[2]) at x + o[0].
-      const float* r00 = &n.distance[Neighbourhood::at(0, y, z)];
-      const float* r10 = &n.distance[Neighbourhood::at(0, y + 1, z)];
-      const float* r01 = &n.distance[Neighbourhood::at(0, y, z + 1)];
-      const float* r11 = &n.distance[Neighbourhood::at(0, y + 1, z + 1)];
+      const float* r00 = &n.distance[Gathered::at(0, y, z)];
+      const float* r10 = &n.distance[Gathered::at(0, y + 1, z)];
+      const float* r01 = &n.distance[Gathered::at(0, y, z + 1)];
+      const float* r11 = &n.distance[Gathered::at(0, y + 1, z + 1)];
       std::array<int, kTsdfBlockSide> masks;
       int any = 0;
       for (int x = 0; x < kTsdfBlockSide; ++x) {
@@ -389,8 +513,23 @@ TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) 
   return mesh;
 }
 
+}  // namespace
+
+TriangleMesh extractBlockMesh(const TsdfMap& map, const Eigen::Vector3i& block) {
+  return map.config().mesh_extrapolate_voxels > 0.0
+             ? extractBlockMeshWith<kExtrapolationMargin>(map, block)
+             : extractBlockMeshWith<1>(map, block);
+}
+
 std::size_t TsdfMesher::update(const TsdfMap& map) {
   last_updated_.clear();
+  const TsdfConfig& config = map.config();
+  if (config.min_weight != meshed_min_weight_ ||
+      config.mesh_extrapolate_voxels != meshed_extrapolate_voxels_) {
+    meshes_.clear();  // every block is extracted again below
+    meshed_min_weight_ = config.min_weight;
+    meshed_extrapolate_voxels_ = config.mesh_extrapolate_voxels;
+  }
   for (auto it = meshes_.begin(); it != meshes_.end();) {
     it = map.find(it->first) == nullptr ? meshes_.erase(it) : std::next(it);
   }

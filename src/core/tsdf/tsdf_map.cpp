@@ -78,6 +78,9 @@ std::string TsdfConfig::validate() const {
   } else if (!(incidence_window_radius_px >= 0 && incidence_window_radius_px <= 64)) {
     why << "incidence_window_radius_px must be in [0, 64] (0 = off), got "
         << incidence_window_radius_px;
+  } else if (!(mesh_extrapolate_voxels >= 0.0 && mesh_extrapolate_voxels <= truncation_voxels)) {
+    why << "mesh_extrapolate_voxels must be in [0, truncation_voxels] (0 = off), got "
+        << mesh_extrapolate_voxels;
   } else if (max_blocks < 1) {
     why << "max_blocks must be >= 1";
   } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {

@@ -50,6 +50,7 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   readParam(pnh, "min_depth_m", &c.min_depth_m, errors);
   readParam(pnh, "max_depth_m", &c.max_depth_m, errors);
   readParam(pnh, "min_weight", &c.min_weight, errors);
+  readParam(pnh, "mesh_extrapolate_voxels", &c.mesh_extrapolate_voxels, errors);
   readParam(pnh, "max_block_distance_m", &c.max_block_distance_m, errors);
   int max_blocks = static_cast<int>(c.max_blocks);
   readParam(pnh, "max_blocks", &max_blocks, errors);

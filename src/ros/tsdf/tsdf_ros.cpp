@@ -176,6 +176,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.min_depth_m = cfg.min_depth_m;
   next.max_depth_m = cfg.max_depth_m;
   next.min_weight = cfg.min_weight;
+  next.mesh_extrapolate_voxels = cfg.mesh_extrapolate_voxels;
   next.max_block_distance_m = cfg.max_block_distance_m;
   std::string why = setNamedTsdfSettings(cfg.weighting, cfg.edge_guard_rule, cfg.max_blocks, &next);
   TsdfSliceConfig next_slice = slice;

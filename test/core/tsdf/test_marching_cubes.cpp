@@ -137,3 +137,136 @@ TEST(MarchingCubes, MesherReExtractsOnlyChangedBlocks) {
   EXPECT_GT(second, 0u);
   EXPECT_LT(second, first / 4);
 }
+
+namespace {
+
+constexpr double kPlaneZ = 0.013;  // m, off the lattice (5 cm voxels)
+
+// The exact distance field of the horizontal plane z = kPlaneZ (inside below it) over lattice
+// x, y in [-12, 12], z in [-6, 6], written where `keep(x, z)` holds.
+TsdfMap planeField(const TsdfConfig& c, const std::function<bool(int, int)>& keep) {
+  TsdfMap map(c);
+  const double mu = c.truncation();
+  fill(&map, Eigen::Vector3i(-12, -12, -6), Eigen::Vector3i(12, 12, 6),
+       [&](const Eigen::Vector3d& p) {
+         const Eigen::Vector3i v = map.voxelAt(p);
+         const double sdf = p.z() - kPlaneZ;
+         if (std::abs(sdf) > mu || !keep(v.x(), v.z())) return std::nan("");
+         return sdf / mu;
+       });
+  return map;
+}
+
+// A slab's top whose edge voxels the guard withheld: the inside voxels (z <= 0) end at x = 3,
+// and beyond it only the first free layer (z = 1) is observed.
+TsdfMap slabTop(const TsdfConfig& c) {
+  return planeField(c, [](int x, int z) { return x <= 3 || z == 1; });
+}
+
+float largestX(const TriangleMesh& mesh) {
+  float x = -std::numeric_limits<float>::infinity();
+  for (const Eigen::Vector3f& v : mesh.vertices) x = std::max(x, v.x());
+  return x;
+}
+
+TsdfConfig extrapolating(double voxels) {
+  TsdfConfig c;
+  c.voxel_size_m = 0.05;
+  c.mesh_extrapolate_voxels = voxels;
+  return c;
+}
+
+}  // namespace
+
+TEST(MarchingCubesExtrapolation, ASlabTopReachesOneVoxelFurtherAlongItsSurface) {
+  // The missing inside voxels at x = 4 continue the two before them along x (equal values:
+  // the surface runs along x), so the cubes up to x = 4 are complete; those at x = 5 would read
+  // a filled voxel, which extrapolation never does, so the mesh stops there. Off (the default)
+  // it ends at x = 3.
+  EXPECT_EQ(TsdfConfig().mesh_extrapolate_voxels, 0.0);
+  const TriangleMesh before = meshOf(slabTop(extrapolating(0.0)));
+  const TriangleMesh after = meshOf(slabTop(extrapolating(2.0)));
+  ASSERT_GT(before.triangleCount(), 100u);
+  EXPECT_NEAR(largestX(before), 3 * 0.05, 1e-5);
+  EXPECT_NEAR(largestX(after), 4 * 0.05, 1e-5);
+  for (const Eigen::Vector3f& v : after.vertices) EXPECT_NEAR(v.z(), kPlaneZ, 1e-5);
+  // Still one sheet, consistently wound: every directed edge once.
+  for (const auto& [edge, count] : meshEdges(after).directed) EXPECT_EQ(count, 1);
+}
+
+TEST(MarchingCubesExtrapolation, ASurfaceSeenOnlyFromItsFreeSideIsExtrapolatedAcrossIt) {
+  // No inside voxel observed: the voxels below the plane continue the free side's field
+  // (stepping one voxel per voxel along z), which crosses zero at the plane; one layer only.
+  const TriangleMesh off = meshOf(planeField(extrapolating(0.0), [](int, int z) { return z > 0; }));
+  const TriangleMesh on = meshOf(planeField(extrapolating(2.0), [](int, int z) { return z > 0; }));
+  EXPECT_EQ(off.triangleCount(), 0u);
+  ASSERT_GT(on.triangleCount(), 500u);
+  for (const Eigen::Vector3f& v : on.vertices) EXPECT_NEAR(v.z(), kPlaneZ, 1e-5);
+}
+
+TEST(MarchingCubesExtrapolation, NoValueIsFilledNextToAVoxelAWholeBandAway) {
+  // The same free side with the column x = 0 of the layer under the plane observed as far free
+  // space (D = +1: a whole band from any surface): a surface within a voxel of it would be a
+  // jump, so its neighbours at x = +-1 stay missing and the mesh has a gap there.
+  TsdfMap map = planeField(extrapolating(2.0), [](int, int z) { return z > 0; });
+  for (int y = -12; y <= 12; ++y) {
+    const Eigen::Vector3i v(0, y, 0);
+    TsdfVoxel& voxel = map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
+    voxel.distance = 1.0f;
+    voxel.weight = 1.0f;
+  }
+  const TriangleMesh mesh = meshOf(map);
+  ASSERT_GT(mesh.triangleCount(), 500u);
+  std::size_t in_gap = 0, beside = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    in_gap += std::abs(v.x()) < 1.5f * 0.05f;
+    beside += std::abs(v.x()) >= 2.0f * 0.05f - 1e-5f && std::abs(v.x()) < 2.5f * 0.05f;
+  }
+  EXPECT_EQ(in_gap, 0u);
+  EXPECT_GT(beside, 0u);
+}
+
+TEST(MarchingCubesExtrapolation, UnconfirmedVoxelsAreNotFilled) {
+  // The slab with its withheld edge voxels unconfirmed (negative weight, as
+  // confirm_depth_voxels marks what was only seen deep behind a surface) instead of missing:
+  // the mesh leaves them out, and extrapolation does not put them back.
+  TsdfMap map = slabTop(extrapolating(2.0));
+  for (int z = -6; z <= 0; ++z) {
+    for (int y = -12; y <= 12; ++y) {
+      const Eigen::Vector3i v(4, y, z);
+      TsdfVoxel& voxel = map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
+      voxel.distance = static_cast<float>((map.voxelCenter(v).z() - kPlaneZ) / 0.2);
+      voxel.weight = -1.0f;
+    }
+  }
+  const TriangleMesh mesh = meshOf(map);
+  ASSERT_GT(mesh.triangleCount(), 100u);
+  EXPECT_NEAR(largestX(mesh), 3 * 0.05, 1e-5);
+}
+
+TEST(MarchingCubesExtrapolation, ChangingAMeshSettingReExtractsEveryBlock) {
+  TsdfConfig c = extrapolating(2.0);
+  TsdfMap map = slabTop(c);
+  TsdfMesher mesher;
+  EXPECT_EQ(mesher.update(map), map.blockCount());
+  EXPECT_NEAR(largestX(mesher.combined()), 4 * 0.05, 1e-5);
+  EXPECT_EQ(mesher.update(map), 0u);
+  c.mesh_extrapolate_voxels = 0.0;
+  ASSERT_EQ(map.setConfig(c), "");
+  EXPECT_EQ(mesher.update(map), map.blockCount());
+  EXPECT_NEAR(largestX(mesher.combined()), 3 * 0.05, 1e-5);
+  c.min_weight = 0.5;
+  ASSERT_EQ(map.setConfig(c), "");
+  EXPECT_EQ(mesher.update(map), map.blockCount());
+  EXPECT_EQ(mesher.update(map), 0u);
+}
+
+TEST(MarchingCubesExtrapolation, ConfigBoundsTheSetting) {
+  TsdfConfig c;
+  for (const double bad : {-0.5, 4.5, std::nan("")}) {
+    c.mesh_extrapolate_voxels = bad;
+    EXPECT_NE(c.validate().find("mesh_extrapolate_voxels"), std::string::npos) << bad;
+  }
+  c.mesh_extrapolate_voxels = 4.0;  // = truncation_voxels
+  EXPECT_EQ(c.validate(), "");
+}

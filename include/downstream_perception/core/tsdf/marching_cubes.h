@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -52,7 +53,8 @@ class TsdfMesher {
   using BlockMeshes = tsl::robin_map<Eigen::Vector3i, TriangleMesh, BlockIndexHash>;
 
   /// Re-extracts the blocks changed since the last call (and their neighbours, whose cubes and
-  /// normals read the changed voxels); drops meshes of blocks that no longer exist. Returns
+  /// normals read the changed voxels), every block when a setting the mesh reads (min_weight,
+  /// mesh_extrapolate_voxels) changed; drops meshes of blocks that no longer exist. Returns
   /// the number of blocks extracted.
   std::size_t update(const TsdfMap& map);
   /// Blocks extracted by the last update().
@@ -67,6 +69,9 @@ class TsdfMesher {
   std::uint64_t last_generation_ = 0;
   std::vector<Eigen::Vector3i> last_updated_;
   float voxel_size_ = 0.0f;  ///< of the map last meshed: where block faces lie in combined()
+  /// The settings the meshes were extracted with (NaN: none yet).
+  double meshed_min_weight_ = std::numeric_limits<double>::quiet_NaN();
+  double meshed_extrapolate_voxels_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace downstream_perception

@@ -131,6 +131,14 @@ struct TsdfConfig {
   double max_depth_m = 10.0;  ///< farther depths are invalid (at most 1000 m)
   /// Voxels whose weight is below this are "unobserved" for meshing and queries.
   double min_weight = 1e-3;
+  /// Marching cubes fills a missing voxel (unobserved, not unconfirmed) next to the surface by
+  /// linear extrapolation along a lattice axis from the two observed voxels before it, the
+  /// nearer within this many voxels of the surface (and keeping its sign), so the mesh reaches
+  /// a surface's edge where the voxel beyond was not written (the edge guard withholds it).
+  /// Mesh only: the TSDF, the ESDF, the slice and queries read the observed voxels. 0 = off
+  /// (the default: on a far floor seen at grazing it still meshed one vertex 2 cm under the
+  /// floor in a gtest's scene; docs/tsdf.md has the measurements); 2 is the measured setting.
+  double mesh_extrapolate_voxels = 0.0;
   /// Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig)
   /// evicts blocks down to the new cap at once: the least recently updated first, among equally
   /// recent ones the farthest from the last sensor origin.
