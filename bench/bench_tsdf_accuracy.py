@@ -83,8 +83,13 @@ Mesh = tuple[np.ndarray, np.ndarray]  # vertices (V, 3), triangles (T, 3)
 Integrator = Callable[[Sequence[np.ndarray], Sequence[np.ndarray], Any, float], Mesh]
 
 
-def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD, dropoff: bool | None = None) -> Integrator:
-    """Ours at this edge guard; dropoff: behind_surface_dropoff (None: the default)."""
+def ours(
+    edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD,
+    dropoff: bool | None = None,
+    extrapolate_voxels: float | None = None,
+) -> Integrator:
+    """Ours at this edge guard; dropoff: behind_surface_dropoff, extrapolate_voxels:
+    mesh_extrapolate_voxels (None: the defaults)."""
 
     def integrate(
         depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any, voxel_m: float
@@ -97,6 +102,8 @@ def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD, dropoff: bool | None = 
         config.edge_guard_rad = edge_guard_rad
         if dropoff is not None:
             config.behind_surface_dropoff = dropoff
+        if extrapolate_voxels is not None:
+            config.mesh_extrapolate_voxels = extrapolate_voxels
         tsdf = dp.Tsdf(config)
         pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
         for depth, pose in zip(depths, poses, strict=True):
@@ -189,17 +196,21 @@ def integrators(
     dropoffs: Sequence[bool | None] = (None,),
     open3d: bool = True,
     legacy_native_lattice: bool = False,
+    extrapolations: Sequence[float | None] = (None,),
 ) -> dict[str, Integrator]:
-    """Ours at each edge guard and behind_surface_dropoff setting (None: the default; the
-    defaults' one named plainly), then Open3D's when it imports (and `open3d`); legacy on our
-    lattice unless legacy_native_lattice."""
+    """Ours at each edge guard, behind_surface_dropoff and mesh_extrapolate_voxels setting
+    (None: the default; the defaults' one named plainly), then Open3D's when it imports (and
+    `open3d`); legacy on our lattice unless legacy_native_lattice."""
     found: dict[str, Integrator] = {}
     for rad in edge_guards:
         for dropoff in dropoffs:
-            name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
-            if dropoff is not None:
-                name += f", behind_surface_dropoff {'on' if dropoff else 'off'}"
-            found[name] = ours(rad, dropoff)
+            for voxels in extrapolations:
+                name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
+                if dropoff is not None:
+                    name += f", behind_surface_dropoff {'on' if dropoff else 'off'}"
+                if voxels is not None:
+                    name += f", mesh_extrapolate_voxels {voxels:g}"
+                found[name] = ours(rad, dropoff, voxels)
     if not open3d:
         return found
     try:
@@ -267,12 +278,13 @@ def run(
     dropoffs: Sequence[bool | None] = (None,),
     open3d: bool = True,
     legacy_native_lattice: bool = False,
+    extrapolations: Sequence[float | None] = (None,),
 ) -> list[Score]:
     from downstream_perception.sim.depth_camera import DepthCamera
     from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
     from downstream_perception.tsdf_eval import observed_samples
 
-    chosen = integrators(edge_guards, dropoffs, open3d, legacy_native_lattice)
+    chosen = integrators(edge_guards, dropoffs, open3d, legacy_native_lattice, extrapolations)
     cameras = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
@@ -463,6 +475,11 @@ def main() -> None:
         default="default",
         help="comma-separated behind_surface_dropoff settings for ours: default, on, off",
     )
+    parser.add_argument(
+        "--mesh-extrapolate",
+        default="default",
+        help="comma-separated mesh_extrapolate_voxels settings for ours: default or voxels",
+    )
     parser.add_argument("--no-open3d", action="store_true", help="ours only")
     parser.add_argument(
         "--legacy-lattice",
@@ -502,6 +519,9 @@ def main() -> None:
         dropoffs=dropoffs,
         open3d=not args.no_open3d,
         legacy_native_lattice=args.legacy_lattice == "native",
+        extrapolations=[
+            None if v == "default" else float(v) for v in args.mesh_extrapolate.split(",")
+        ],
     )
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
