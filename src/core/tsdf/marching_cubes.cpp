@@ -175,18 +175,23 @@ struct Extrapolation {
 /// - along the surface, the two agree within a quarter voxel: the value keeps D1's sign and
 ///   continues the surface sideways (the edge the guard withheld). Measured: half a voxel let a
 ///   far floor's projective ramp, seen at grazing, run on one voxel under the floor;
-/// - across it, they step by 0.9 to 1.2 voxels (a distance field's slope, one voxel per voxel
-///   along the normal, within rounding and fusion's noise):
-///   the value changes sign, a surface just beyond the observed voxels. Other steps fill
-///   nothing (under depth noise, D1 - D2 along a wall is noise, and doubling it
-///   flipped signs behind walls);
+/// - across it, they step by 0.9 to 1.05 voxels (a distance field's slope, one voxel per voxel
+///   along the normal, within rounding and fusion's noise) and D1's four neighbours across the
+///   axis lie within half a voxel of it (the surface faces the axis within 30 degrees): the
+///   value changes sign, a surface just beyond the observed voxels. Other steps fill nothing
+///   (under depth noise, D1 - D2 along a wall is noise, and doubling it flipped signs behind
+///   walls). Measured: steps up to 1.2 continued the ray distance seen obliquely at the
+///   frustum's edge (a plane's rim 0.7 mm off), and without the neighbour test a far floor's
+///   projective ramp (D1 positive under the floor, its neighbours a voxel apart) was continued
+///   2 cm under the floor;
 /// - no observed neighbour of the opposite sign lies a whole band (|D| ~ 1) from any surface:
 ///   a crossing between the two would be a jump, not a surface.
 /// Where several axes qualify, their mean, unless their signs differ (then it stays missing).
 /// Reads only observed voxels, so a filled voxel is the same in every block that reads it.
 void extrapolate(const Extrapolation& e, Extrapolated* n) {
   constexpr int kPad = Extrapolated::kPad;
-  constexpr float kAlongSurface = 0.25f, kAcrossMin = 0.9f, kAcrossMax = 1.2f, kWholeBand = 0.99f;
+  constexpr float kAlongSurface = 0.25f, kAcrossMin = 0.9f, kAcrossMax = 1.05f, kWholeBand = 0.99f;
+  constexpr float kAcrossSideways = 0.5f;
   constexpr std::array<int, 6> kNeighbours = {1, -1, kPad, -kPad, kPad * kPad, -kPad * kPad};
   const Extrapolated& source = *n;
   auto filled = n->distance;
@@ -206,7 +211,13 @@ void extrapolate(const Extrapolation& e, Extrapolated* n) {
           const float value = 2.0f * d1 - d2;
           const bool flips = (value < 0.0f) != (d1 < 0.0f);
           const bool along = !flips && step <= kAlongSurface * e.voxel;
-          const bool across = flips && step >= kAcrossMin * e.voxel && step <= kAcrossMax * e.voxel;
+          bool across = flips && step >= kAcrossMin * e.voxel && step <= kAcrossMax * e.voxel;
+          for (const int l : kNeighbours) {
+            if (!across) break;
+            if (l == q || l == -q) continue;
+            const float dl = source.distance[i + q + l];
+            across = !(isObserved(dl) && std::abs(dl - d1) > kAcrossSideways * e.voxel);
+          }
           if (!(along || across)) continue;
           sum += value;
           ++count;

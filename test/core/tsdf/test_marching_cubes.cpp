@@ -181,9 +181,9 @@ TsdfConfig extrapolating(double voxels) {
 TEST(MarchingCubesExtrapolation, ASlabTopReachesOneVoxelFurtherAlongItsSurface) {
   // The missing inside voxels at x = 4 continue the two before them along x (equal values:
   // the surface runs along x), so the cubes up to x = 4 are complete; those at x = 5 would read
-  // a filled voxel, which extrapolation never does, so the mesh stops there. Off (the default)
-  // it ends at x = 3.
-  EXPECT_EQ(TsdfConfig().mesh_extrapolate_voxels, 0.0);
+  // a filled voxel, which extrapolation never does, so the mesh stops there. Off it ends at
+  // x = 3.
+  EXPECT_EQ(TsdfConfig().mesh_extrapolate_voxels, 2.0);  // on by default
   const TriangleMesh before = meshOf(slabTop(extrapolating(0.0)));
   const TriangleMesh after = meshOf(slabTop(extrapolating(2.0)));
   ASSERT_GT(before.triangleCount(), 100u);
@@ -202,6 +202,52 @@ TEST(MarchingCubesExtrapolation, ASurfaceSeenOnlyFromItsFreeSideIsExtrapolatedAc
   EXPECT_EQ(off.triangleCount(), 0u);
   ASSERT_GT(on.triangleCount(), 500u);
   for (const Eigen::Vector3f& v : on.vertices) EXPECT_NEAR(v.z(), kPlaneZ, 1e-5);
+}
+
+TEST(MarchingCubesExtrapolation, AFieldSteeperThanADistanceFieldIsNotContinuedAcross) {
+  // The free side of the plane as a depth camera sees it 25 degrees off its normal: the ray
+  // distance, 1.1 voxels per voxel along z. Its zero still lies on the plane, but continued
+  // beyond the observed voxels a projective field's slope changes with the ray: the mesh stays
+  // empty rather than guessing (steps up to 1.05 are a distance field's, within noise).
+  const auto steep = [](float slope) {
+    TsdfConfig c = extrapolating(2.0);
+    TsdfMap map = planeField(c, [](int, int z) { return z > 0; });
+    for (int z = 1; z <= 6; ++z) {
+      for (int y = -12; y <= 12; ++y) {
+        for (int x = -12; x <= 12; ++x) {
+          const Eigen::Vector3i v(x, y, z);
+          TsdfVoxel& voxel = map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)];
+          if (voxel.weight > 0.0f) voxel.distance = std::min(1.0f, voxel.distance * slope);
+        }
+      }
+    }
+    return meshOf(map);
+  };
+  EXPECT_GT(steep(1.04).triangleCount(), 500u);
+  EXPECT_EQ(steep(1.1).triangleCount(), 0u);
+}
+
+TEST(MarchingCubesExtrapolation, AColumnOutOfStepWithItsNeighboursIsNotContinuedAcross) {
+  // The free side with the column x = 0 raised by 0.6 voxels (its step along z unchanged): the
+  // surface there would face 37 degrees or more off z, or the column is a projective ramp's
+  // noise (a far floor at grazing: a voxel under the floor read positive). Its own fill and its
+  // neighbours' (x = +-1, whose D1 has the raised column beside it) stay missing; continued, the
+  // column would have meshed 3 cm under the plane.
+  TsdfMap map = planeField(extrapolating(2.0), [](int, int z) { return z > 0; });
+  for (int z = 1; z <= 2; ++z) {
+    for (int y = -12; y <= 12; ++y) {
+      const Eigen::Vector3i v(0, y, z);
+      map.allocate(TsdfMap::blockOf(v))->voxels[TsdfMap::localIndex(v)].distance += 0.6f * 0.25f;
+    }
+  }
+  const TriangleMesh mesh = meshOf(map);
+  ASSERT_GT(mesh.triangleCount(), 500u);
+  std::size_t in_gap = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    EXPECT_NEAR(v.z(), kPlaneZ, 1e-5);
+    in_gap += std::abs(v.x()) < 1.5f * 0.05f;
+  }
+  EXPECT_EQ(in_gap, 0u);
 }
 
 TEST(MarchingCubesExtrapolation, NoValueIsFilledNextToAVoxelAWholeBandAway) {

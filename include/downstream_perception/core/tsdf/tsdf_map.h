@@ -136,9 +136,9 @@ struct TsdfConfig {
   /// nearer within this many voxels of the surface (and keeping its sign), so the mesh reaches
   /// a surface's edge where the voxel beyond was not written (the edge guard withholds it).
   /// Mesh only: the TSDF, the ESDF, the slice and queries read the observed voxels. 0 = off
-  /// (the default: on a far floor seen at grazing it still meshed one vertex 2 cm under the
-  /// floor in a gtest's scene; docs/tsdf.md has the measurements); 2 is the measured setting.
-  double mesh_extrapolate_voxels = 0.0;
+  /// (the mesh as before 2026-12: it ends a cube short of such edges); docs/tsdf.md has the
+  /// measurements.
+  double mesh_extrapolate_voxels = 2.0;
   /// Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig)
   /// evicts blocks down to the new cap at once: the least recently updated first, among equally
   /// recent ones the farthest from the last sensor origin.
