@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -193,14 +194,29 @@ void extrapolate(const Extrapolation& e, Extrapolated* n) {
   constexpr float kAlongSurface = 0.25f, kAcrossMin = 0.9f, kAcrossMax = 1.05f, kWholeBand = 0.99f;
   constexpr float kAcrossSideways = 0.5f;
   constexpr std::array<int, 6> kNeighbours = {1, -1, kPad, -kPad, kPad * kPad, -kPad * kPad};
+  constexpr int kSide = kTsdfBlockSide + 3;  // -1 .. 9
   const Extrapolated& source = *n;
-  auto filled = n->distance;
+  // Applied after the scan, so every fill reads observed voxels only.
+  std::array<int, kSide * kSide * kSide> fill_at;
+  std::array<float, kSide * kSide * kSide> fill_value;
+  int fills = 0;
+  // Every fill reads a D1 within `near` of the surface: the voxels with none beside them (most
+  // of the missing ones, deep behind surfaces) are passed over at the cost of six byte reads.
+  std::array<std::uint8_t, Extrapolated::kPad * kPad * kPad> near_surface;
+  for (std::size_t k = 0; k < near_surface.size(); ++k) {
+    near_surface[k] = std::abs(source.distance[k]) <= e.near;  // NaN: 0
+  }
   for (int z = -1; z <= kTsdfBlockSide + 1; ++z) {
     for (int y = -1; y <= kTsdfBlockSide + 1; ++y) {
       for (int x = -1; x <= kTsdfBlockSide + 1; ++x) {
         const int i = Extrapolated::at(x, y, z);
         const float d0 = source.distance[i];
         if (isObserved(d0) || isUnconfirmed(d0)) continue;
+        if (!(near_surface[i + 1] | near_surface[i - 1] | near_surface[i + kPad] |
+              near_surface[i - kPad] | near_surface[i + kPad * kPad] |
+              near_surface[i - kPad * kPad])) {
+          continue;
+        }
         float sum = 0.0f;
         int count = 0, negative = 0;
         for (const int q : kNeighbours) {
@@ -230,11 +246,14 @@ void extrapolate(const Extrapolation& e, Extrapolated* n) {
           const float d = source.distance[i + q];
           jump |= isObserved(d) && (d < 0.0f) != (value < 0.0f) && std::abs(d) > kWholeBand;
         }
-        if (!jump) filled[i] = value;
+        if (!jump) {
+          fill_at[fills] = i;
+          fill_value[fills++] = value;
+        }
       }
     }
   }
-  n->distance = filled;
+  for (int k = 0; k < fills; ++k) n->distance[fill_at[k]] = fill_value[k];
 }
 
 /// Whether a cube of the block (corners at lattice 0 .. 8) holds both a negative and a
@@ -254,18 +273,20 @@ bool holdsSurface(const Neighbourhood<Margin>& n) {
   return negative && non_negative;
 }
 
-/// Whether extrapolation could give the block's corners a surface: they or the voxels it reads
-/// hold both signs, or a value within `near` of zero (every fill reads one, so without it the
-/// block, seen only far in front of or behind surfaces, stays as gathered).
+/// Whether extrapolation could give the block's corners a surface: they hold both signs, or a
+/// voxel a fill may read as D1 (lattice -2 .. 10) lies within `near` of zero (without one
+/// nothing is filled, and the block, seen only far in front of or behind surfaces, stays as
+/// gathered).
 bool mayHoldSurface(const Extrapolated& n, float near) {
-  bool negative = false, non_negative = false;
-  for (std::size_t i = 0; i < n.distance.size(); ++i) {
-    const float d = n.distance[i];
-    if (std::abs(d) <= near) return true;
-    negative |= d < 0.0f;
-    non_negative |= d >= 0.0f;
+  for (int z = -2; z <= kTsdfBlockSide + 2; ++z) {
+    for (int y = -2; y <= kTsdfBlockSide + 2; ++y) {
+      const float* row = &n.distance[Extrapolated::at(0, y, z)];
+      bool any = false;
+      for (int x = -2; x <= kTsdfBlockSide + 2; ++x) any |= std::abs(row[x]) <= near;
+      if (any) return true;
+    }
   }
-  return negative && non_negative;
+  return holdsSurface(n);
 }
 
 /// Fills n; returns whether a cube of the block can hold a surface: its corners (lattice
@@ -308,11 +329,17 @@ bool gather(const TsdfMap& map, const Eigen::Vector3i& block, Neighbourhood<Marg
       split(y, &oy, &ly);
       const int row_blocks = 3 * ((oy + 1) + 3 * (oz + 1));
       float* out = &n->distance[Neighbourhood<Margin>::at(0, y, z)];
-      for (int x = first; x <= last; ++x) {
-        if (x == 0) x = kTsdfBlockSide;
-        const TsdfBlock* b = around[row_blocks + (x < 0 ? 0 : 2)];
-        const int lx = x < 0 ? x + kTsdfBlockSide : x - kTsdfBlockSide;
-        out[x] = b == nullptr ? kMissing : gathered(b->voxels[TsdfBlock::linear(lx, ly, lz)]);
+      const TsdfBlock* left = around[row_blocks];
+      const TsdfBlock* right = around[row_blocks + 2];
+      for (int x = first; x < 0; ++x) {
+        out[x] = left == nullptr
+                     ? kMissing
+                     : gathered(left->voxels[TsdfBlock::linear(x + kTsdfBlockSide, ly, lz)]);
+      }
+      for (int x = kTsdfBlockSide; x <= last; ++x) {
+        out[x] = right == nullptr
+                     ? kMissing
+                     : gathered(right->voxels[TsdfBlock::linear(x - kTsdfBlockSide, ly, lz)]);
       }
       const TsdfBlock* centre = around[row_blocks + 1];
       if (centre != nullptr) {
