@@ -50,10 +50,12 @@ def ours(
     cam: Any,
     rule_before_defect_4: bool = False,
     incidence_window: bool = True,
+    mesh_extrapolation: bool = True,
 ) -> Timing:
     """Default settings; rule_before_defect_4: the fixed-radius edge guard without the grazing
     reach (issue 22's rule before defect 4, cheaper per pixel); incidence_window False:
-    incidences from each pixel's nearest neighbours only (incidence_window_radius_px 0)."""
+    incidences from each pixel's nearest neighbours only (incidence_window_radius_px 0);
+    mesh_extrapolation False: mesh_extrapolate_voxels 0 (the mesh before 2026-12-06)."""
     import downstream_perception as dp
 
     config = dp.TsdfConfig()
@@ -64,6 +66,8 @@ def ours(
         config.grazing_reach_voxels = 0.0
     if not incidence_window:
         config.incidence_window_radius_px = 0
+    if not mesh_extrapolation:
+        config.mesh_extrapolate_voxels = 0.0
     tsdf = dp.Tsdf(config)
     pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
     elapsed = timed_frames(tsdf.integrate_depth, depths, pinhole, poses)
@@ -209,6 +213,7 @@ def main() -> None:
         "downstream_perception": ours,
         "ours, fixed-radius guard": lambda d, p, c: ours(d, p, c, rule_before_defect_4=True),
         "ours, no incidence window": lambda d, p, c: ours(d, p, c, incidence_window=False),
+        "ours, no mesh extrapolation": lambda d, p, c: ours(d, p, c, mesh_extrapolation=False),
         "Open3D tensor": open3d_tensor,
         "Open3D legacy": open3d_legacy,
     }
