@@ -202,7 +202,7 @@ void extrapolate(const Extrapolation& e, Extrapolated* n) {
   int fills = 0;
   // Every fill reads a D1 within `near` of the surface: the voxels with none beside them (most
   // of the missing ones, deep behind surfaces) are passed over at the cost of six byte reads.
-  std::array<std::uint8_t, Extrapolated::kPad * kPad * kPad> near_surface;
+  std::array<std::uint8_t, kPad * kPad * kPad> near_surface;
   for (std::size_t k = 0; k < near_surface.size(); ++k) {
     near_surface[k] = std::abs(source.distance[k]) <= e.near;  // NaN: 0
   }
