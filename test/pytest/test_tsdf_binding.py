@@ -679,6 +679,9 @@ def test_mesh_extrapolation_reaches_edges_live_and_mesh_only(offset_voxels: floa
     after = tsdf.sample(probe)
     np.testing.assert_array_equal(before[0], after[0])
     np.testing.assert_array_equal(before[1], after[1])
-    config.mesh_extrapolate_voxels = 4.5  # beyond truncation_voxels
+    config.mesh_extrapolate_voxels = 64.5  # beyond its range
     with pytest.raises(ValueError, match="mesh_extrapolate_voxels"):
         tsdf.set_config(config)
+    config.mesh_extrapolate_voxels = 2.0
+    config.truncation_voxels = 1.5  # the default reaches farther: still a valid configuration
+    assert dp.Tsdf(config).config.mesh_extrapolate_voxels == 2.0

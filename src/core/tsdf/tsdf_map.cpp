@@ -33,6 +33,10 @@ std::string TsdfConfig::inertSettings() const {
   } else if (incidence_window_radius_px != defaults.incidence_window_radius_px &&
              incidence_window_radius_px > 0 && !estimates_incidences) {
     why << "incidence_window_radius_px " << incidence_window_radius_px << no_incidences;
+  } else if (mesh_extrapolate_voxels != defaults.mesh_extrapolate_voxels &&
+             mesh_extrapolate_voxels > truncation_voxels) {
+    why << "mesh_extrapolate_voxels " << mesh_extrapolate_voxels << " acts as truncation_voxels "
+        << truncation_voxels << " (no voxel lies farther from the surface)";
   }
   return why.str();
 }
@@ -78,9 +82,9 @@ std::string TsdfConfig::validate() const {
   } else if (!(incidence_window_radius_px >= 0 && incidence_window_radius_px <= 64)) {
     why << "incidence_window_radius_px must be in [0, 64] (0 = off), got "
         << incidence_window_radius_px;
-  } else if (!(mesh_extrapolate_voxels >= 0.0 && mesh_extrapolate_voxels <= truncation_voxels)) {
-    why << "mesh_extrapolate_voxels must be in [0, truncation_voxels] (0 = off), got "
-        << mesh_extrapolate_voxels;
+  } else if (!(mesh_extrapolate_voxels >= 0.0 && mesh_extrapolate_voxels <= 64.0)) {
+    // Not bounded by truncation_voxels: the default (2) must not refuse a map truncated at 1.5.
+    why << "mesh_extrapolate_voxels must be in [0, 64] (0 = off), got " << mesh_extrapolate_voxels;
   } else if (max_blocks < 1) {
     why << "max_blocks must be >= 1";
   } else if (!(std::isfinite(max_block_distance_m) && max_block_distance_m >= 0.0)) {

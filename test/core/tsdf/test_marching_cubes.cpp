@@ -309,10 +309,23 @@ TEST(MarchingCubesExtrapolation, ChangingAMeshSettingReExtractsEveryBlock) {
 
 TEST(MarchingCubesExtrapolation, ConfigBoundsTheSetting) {
   TsdfConfig c;
-  for (const double bad : {-0.5, 4.5, std::nan("")}) {
+  for (const double bad : {-0.5, 64.5, std::nan(""), std::numeric_limits<double>::infinity()}) {
     c.mesh_extrapolate_voxels = bad;
     EXPECT_NE(c.validate().find("mesh_extrapolate_voxels"), std::string::npos) << bad;
   }
-  c.mesh_extrapolate_voxels = 4.0;  // = truncation_voxels
+  // The default must not refuse a map truncated closer than it reaches (a configuration valid
+  // before it was on), nor be named as inert there.
+  TsdfConfig thin;
+  thin.truncation_voxels = 1.5;
+  EXPECT_EQ(thin.validate(), "");
+  EXPECT_EQ(thin.inertSettings(), "");
+  // Set beyond truncation_voxels, it acts as truncation_voxels (said once by the nodelet).
+  c.mesh_extrapolate_voxels = 6.0;
   EXPECT_EQ(c.validate(), "");
+  EXPECT_NE(c.inertSettings().find("mesh_extrapolate_voxels 6 acts as truncation_voxels 4"),
+            std::string::npos);
+  const TriangleMesh capped = meshOf(slabTop(extrapolating(6.0)));
+  const TriangleMesh at_truncation = meshOf(slabTop(extrapolating(4.0)));
+  EXPECT_EQ(capped.vertices, at_truncation.vertices);
+  EXPECT_EQ(capped.triangles, at_truncation.triangles);
 }

@@ -136,8 +136,8 @@ struct TsdfConfig {
   /// nearer within this many voxels of the surface (and keeping its sign), so the mesh reaches
   /// a surface's edge where the voxel beyond was not written (the edge guard withholds it).
   /// Mesh only: the TSDF, the ESDF, the slice and queries read the observed voxels. 0 = off
-  /// (the mesh as before 2026-12: it ends a cube short of such edges); docs/tsdf.md has the
-  /// measurements.
+  /// (the mesh as before 2026-12: it ends a cube short of such edges); above truncation_voxels
+  /// it acts as truncation_voxels; docs/tsdf.md has the measurements.
   double mesh_extrapolate_voxels = 2.0;
   /// Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig)
   /// evicts blocks down to the new cap at once: the least recently updated first, among equally
