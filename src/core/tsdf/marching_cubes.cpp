@@ -437,7 +437,6 @@ TriangleMesh extractBlockMeshWith(const TsdfMap& map, const Eigen::Vector3i& blo
   Gathered n;
   // A block without a surface is done after the gather.
   if (!gather(map, block, &n)) return mesh;
-  const auto observed = isObserved;
   // Gradient of D (per voxel) by central differences, one-sided where a neighbour is missing.
   const auto gradient = [&](int x, int y, int z) {
     Eigen::Vector3f g = Eigen::Vector3f::Zero();
@@ -449,11 +448,11 @@ TriangleMesh extractBlockMeshWith(const TsdfMap& map, const Eigen::Vector3i& blo
       ++hi[a];
       const float vl = n(lo[0], lo[1], lo[2]);
       const float vh = n(hi[0], hi[1], hi[2]);
-      if (observed(vl) && observed(vh)) {
+      if (isObserved(vl) && isObserved(vh)) {
         g(a) = 0.5f * (vh - vl);
-      } else if (observed(vh) && observed(vc)) {
+      } else if (isObserved(vh) && isObserved(vc)) {
         g(a) = vh - vc;
-      } else if (observed(vl) && observed(vc)) {
+      } else if (isObserved(vl) && isObserved(vc)) {
         g(a) = vc - vl;
       }
     }
@@ -485,7 +484,7 @@ TriangleMesh extractBlockMeshWith(const TsdfMap& map, const Eigen::Vector3i& blo
         bool complete = true;
         for (int k = 0; k < 8; ++k) {
           mask |= (c[k] < 0.0f) << k;
-          complete &= observed(c[k]);
+          complete &= isObserved(c[k]);
         }
         masks[x] = complete && mask != 255 ? mask : 0;
         any |= masks[x];
