@@ -420,6 +420,10 @@ class TsdfConfig:
     Parameters of the sparse TSDF (voxel size and truncation in metres, weights, memory bounds).
     """
     def __init__(self) -> None: ...
+    def confirm_depth(self) -> float:
+        """
+        The confirm depth in effect (m along the normal): confirm_depth_voxels voxels, at most confirm_depth_max_m unless that is under 1.25 voxels.
+        """
     def truncation(self) -> float:
         """
         mu in metres
@@ -458,6 +462,20 @@ class TsdfConfig:
         """
     @confirm_depth_voxels.setter
     def confirm_depth_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def confirm_depth_max_m(self) -> float:
+        """
+        Caps the confirm depth (m along the normal; 0 = no cap), never below 1.25 voxels: a slab thinner than a few coarse voxels grows no far side.
+        """
+    @confirm_depth_max_m.setter
+    def confirm_depth_max_m(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
+    def unconfirmed_update_weight(self) -> float:
+        """
+        Depth images: an update deeper than the confirm depth behind its surface (it does not confirm its voxel) fuses with its weight times this, so frames that see the voxel free outweigh it (no skirt under a thin slab seen from above). In (0, 1]; 1 = equal weights.
+        """
+    @unconfirmed_update_weight.setter
+    def unconfirmed_update_weight(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
     def carve_free_space(self) -> bool:
         """
@@ -556,7 +574,7 @@ class TsdfConfig:
     @property
     def mesh_extrapolate_voxels(self) -> float:
         """
-        Marching cubes fills a missing voxel (unobserved, not unconfirmed) next to the surface by linear extrapolation along a lattice axis from the two observed voxels before it, the nearer within this many voxels of the surface (keeping its sign), so the mesh reaches a surface's edge where the voxel beyond was not written. Mesh only. 0 = off.
+        Marching cubes fills a missing voxel (unobserved, not unconfirmed) next to the surface by linear extrapolation along a lattice axis from the two observed voxels before it, the nearer within this many voxels of the surface (keeping its sign), so the mesh reaches a surface's edge where the voxel beyond was not written. Mesh only. 0 = off; above truncation_voxels it acts as truncation_voxels.
         """
     @mesh_extrapolate_voxels.setter
     def mesh_extrapolate_voxels(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...

@@ -247,6 +247,17 @@ void bindTsdf(py::module& m) {
                      "and sample() read it, but the mesh leaves it out until a frame sees it "
                      "nearer a surface or in front of one (a thin slab's unseen underside). "
                      "0 = off.")
+      .def_readwrite("confirm_depth_max_m", &TsdfConfig::confirm_depth_max_m,
+                     "Caps the confirm depth (m along the normal; 0 = no cap), never below 1.25 "
+                     "voxels: a slab thinner than a few coarse voxels grows no far side.")
+      .def("confirm_depth", &TsdfConfig::confirmDepth,
+           "The confirm depth in effect (m along the normal): confirm_depth_voxels voxels, at "
+           "most confirm_depth_max_m unless that is under 1.25 voxels.")
+      .def_readwrite("unconfirmed_update_weight", &TsdfConfig::unconfirmed_update_weight,
+                     "Depth images: an update deeper than the confirm depth behind its surface "
+                     "(it does not confirm its voxel) fuses with its weight times this, so frames "
+                     "that see the voxel free outweigh it (no skirt under a thin slab seen from "
+                     "above). In (0, 1]; 1 = equal weights.")
       .def_readwrite("edge_guard_rule", &TsdfConfig::edge_guard_rule,
                      "Depth images: how deep behind the surface pixels next to a depth edge (an "
                      "object's rim) write inside values (rays grazing a rim would otherwise "
@@ -309,7 +320,8 @@ void bindTsdf(py::module& m) {
           "Marching cubes fills a missing voxel (unobserved, not unconfirmed) next to the surface "
           "by linear extrapolation along a lattice axis from the two observed voxels before it, "
           "the nearer within this many voxels of the surface (keeping its sign), so the mesh "
-          "reaches a surface's edge where the voxel beyond was not written. Mesh only. 0 = off.")
+          "reaches a surface's edge where the voxel beyond was not written. Mesh only. 0 = off; "
+          "above truncation_voxels it acts as truncation_voxels.")
       .def_readwrite(
           "max_blocks", &TsdfConfig::max_blocks,
           "Hard cap: new blocks beyond it are not allocated. Lowering it on a live map (setConfig) "

@@ -1259,6 +1259,8 @@ def tsdf_config_args(g: Gen) -> dict[str, Any]:
         "behind_surface_dropoff": g.b(),
         "behind_surface_dropoff_start_voxels": g.f(0, 6, 0.1),
         "confirm_depth_voxels": g.f(0, 5, 0.1),
+        "confirm_depth_max_m": g.f(0, 0.2, 0.1),
+        "unconfirmed_update_weight": g.f(0.01, 1, 0.1),
         "incidence_window_radius_px": g.i(0, 8, 0.1),
         "edge_guard_rad": g.f(0, 0.01, 0.1),
         "edge_guard_near_side_only": g.b(),

@@ -136,6 +136,8 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "behind_surface_dropoff",
         "behind_surface_dropoff_start_voxels",
         "confirm_depth_voxels",
+        "confirm_depth_max_m",
+        "unconfirmed_update_weight",
         "incidence_window_radius_px",
         "edge_guard_rad",
         "edge_guard_near_side_only",

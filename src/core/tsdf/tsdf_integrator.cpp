@@ -141,15 +141,15 @@ struct DepthFrame {
   float min_depth = std::numeric_limits<float>::infinity();
 };
 
-/// f->confirm_depth from the incidences (f->cosine): along the normal confirm_depth_voxels
-/// voxels behind the surface is that over the cosine along the ray. Unknown incidences confirm
+/// f->confirm_depth from the incidences (f->cosine): TsdfConfig::confirmDepth() behind the
+/// surface along the normal is that over the cosine along the ray. Unknown incidences confirm
 /// at any depth (the frame cannot tell how deep along the normal its ray is).
-void confirmDepths(const TsdfConfig& c, float voxel, DepthFrame* f) {
+void confirmDepths(const TsdfConfig& c, DepthFrame* f) {
   if (!(c.confirm_depth_voxels > 0.0) || f->cosine.empty()) {
     f->confirm_depth.clear();
     return;
   }
-  const float along_normal = static_cast<float>(c.confirm_depth_voxels) * voxel;
+  const float along_normal = static_cast<float>(c.confirmDepth());
   const float inf = std::numeric_limits<float>::infinity();
   f->confirm_depth.resize(f->cosine.size());
   for (std::size_t i = 0; i < f->cosine.size(); ++i) {
@@ -579,7 +579,7 @@ DP_INTEGRATION_STEP void prepare(const float* depth, const PinholeCamera& camera
   } else {
     f.allowed.clear();
   }
-  confirmDepths(c, rs.voxel, &f);
+  confirmDepths(c, &f);
 }
 
 /// Blocks the truncation band of the valid pixels passes through, from mu in front of the
@@ -758,6 +758,8 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
   alignas(32) float confirm_depth[kTsdfBlockSide] = {};
   const bool has_confirm_depth = !frame.confirm_depth.empty();
   const float* confirm_depth_px = frame.confirm_depth.data();
+  // A non-confirming update's weight factor (TsdfConfig::unconfirmed_update_weight).
+  const float unconfirmed_weight = static_cast<float>(map->config().unconfirmed_update_weight);
   // The blocks are found (or allocated) first, so each block's integration can prefetch the
   // next block's voxels: blocks lie scattered in memory, where the hardware prefetcher does not
   // follow.
@@ -909,10 +911,11 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
           const float dn = std::max(-1.0f, std::min(1.0f, sdf * inv_mu));
           const float obs_w = weight(no_return ? z_axis : nearest[x], sdf);
           TsdfVoxel& voxel = row_voxels[x];
-          // Deeper than confirm_depth_voxels along the normal: the update fuses but does not
-          // confirm the voxel (a slab's far side, which no frame may ever see).
+          // Deeper than the confirm depth along the normal: the update fuses, at a lower weight,
+          // but does not confirm the voxel (a slab's far side, which no frame may ever see).
           const bool confirms = !(in_band & (sdf < -confirm_depth[x]));
-          const TsdfVoxel fused = map->fused(voxel, dn, obs_w, confirms);
+          const TsdfVoxel fused =
+              map->fused(voxel, dn, confirms ? obs_w : obs_w * unconfirmed_weight, confirms);
           voxel.distance = update ? fused.distance : voxel.distance;
           voxel.weight = update ? fused.weight : voxel.weight;
           updated += update;

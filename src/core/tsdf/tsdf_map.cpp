@@ -30,6 +30,18 @@ std::string TsdfConfig::inertSettings() const {
   } else if (confirm_depth_voxels != defaults.confirm_depth_voxels && confirm_depth_voxels > 0.0 &&
              !estimates_incidences) {
     why << "confirm_depth_voxels " << confirm_depth_voxels << no_incidences;
+  } else if (confirm_depth_max_m != defaults.confirm_depth_max_m &&
+             (!(confirm_depth_voxels > 0.0) || !estimates_incidences)) {
+    why << "confirm_depth_max_m " << confirm_depth_max_m
+        << (confirm_depth_voxels > 0.0
+                ? no_incidences
+                : " has no effect with confirm_depth_voxels 0 (every update confirms)");
+  } else if (unconfirmed_update_weight != defaults.unconfirmed_update_weight &&
+             (!(confirm_depth_voxels > 0.0) || !estimates_incidences)) {
+    why << "unconfirmed_update_weight " << unconfirmed_update_weight
+        << (confirm_depth_voxels > 0.0
+                ? no_incidences
+                : " has no effect with confirm_depth_voxels 0 (every update confirms)");
   } else if (incidence_window_radius_px != defaults.incidence_window_radius_px &&
              incidence_window_radius_px > 0 && !estimates_incidences) {
     why << "incidence_window_radius_px " << incidence_window_radius_px << no_incidences;
@@ -39,6 +51,12 @@ std::string TsdfConfig::inertSettings() const {
         << truncation_voxels << " (no voxel lies farther from the surface)";
   }
   return why.str();
+}
+
+double TsdfConfig::confirmDepth() const {
+  const double depth = confirm_depth_voxels * voxel_size_m;
+  if (!(confirm_depth_max_m > 0.0)) return depth;
+  return std::min(depth, std::max(confirm_depth_max_m, kConfirmDepthFloorVoxels * voxel_size_m));
 }
 
 std::string TsdfConfig::validate() const {
@@ -79,6 +97,11 @@ std::string TsdfConfig::validate() const {
         << behind_surface_dropoff_start_voxels;
   } else if (!(confirm_depth_voxels >= 0.0 && confirm_depth_voxels <= 64.0)) {
     why << "confirm_depth_voxels must be in [0, 64] (0 = off), got " << confirm_depth_voxels;
+  } else if (!(confirm_depth_max_m >= 0.0 && confirm_depth_max_m <= 100.0)) {
+    why << "confirm_depth_max_m must be in [0, 100] m (0 = no cap), got " << confirm_depth_max_m;
+  } else if (!(unconfirmed_update_weight > 0.0 && unconfirmed_update_weight <= 1.0)) {
+    why << "unconfirmed_update_weight must be in (0, 1] (1 = as a confirming update), got "
+        << unconfirmed_update_weight;
   } else if (!(incidence_window_radius_px >= 0 && incidence_window_radius_px <= 64)) {
     why << "incidence_window_radius_px must be in [0, 64] (0 = off), got "
         << incidence_window_radius_px;

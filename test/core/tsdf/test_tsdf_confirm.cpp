@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "downstream_perception/core/tsdf/esdf.h"
@@ -82,13 +83,11 @@ struct SlabCount {
 };
 
 /// The benchmark's room (sim.scenes.room) seen by its 320 x 240 camera from the 30 poses of its
-/// circle, the scene moved off the 2 cm lattice by `offset_voxels` on every axis; counts of the
+/// circle, the scene moved off the lattice by `offset_voxels` on every axis; counts of the
 /// mesh's vertices under the table top's footprint (x -1.2..-0.4, y 0.4..1.0; the top spans
-/// z 0.72..0.76) more than a voxel below its underside and above the floor's band.
-SlabCount tableTopSkirt(double confirm_depth_voxels, double offset_voxels) {
-  TsdfConfig c;
-  c.voxel_size_m = 0.02;
-  c.confirm_depth_voxels = confirm_depth_voxels;
+/// z 0.72..0.76) more than a voxel below its underside and above the floor's band. `c`: the
+/// map's settings (voxel_size_m 2 cm unless set).
+SlabCount tableTopSkirt(TsdfConfig c, double offset_voxels) {
   TsdfMap map(c);
   DepthIntegrator integrator;
   RoomScene scene;
@@ -113,16 +112,25 @@ SlabCount tableTopSkirt(double confirm_depth_voxels, double offset_voxels) {
 
 }  // namespace
 
+TsdfConfig withConfirmDepth(double confirm_depth_voxels) {
+  TsdfConfig c;
+  c.voxel_size_m = 0.02;
+  c.confirm_depth_voxels = confirm_depth_voxels;
+  return c;
+}
+
 TEST(TsdfConfirm, TheTableTopGrowsNoSkirtBelowItsUnderside) {
   for (const double offset : {0.0, 0.75}) {
-    const SlabCount off = tableTopSkirt(0.0, offset);
-    const SlabCount on = tableTopSkirt(TsdfConfig().confirm_depth_voxels, offset);
+    const SlabCount off = tableTopSkirt(withConfirmDepth(0.0), offset);
+    const SlabCount on = tableTopSkirt(withConfirmDepth(TsdfConfig().confirm_depth_voxels), offset);
     std::printf("offset %.2f voxel: skirt vertices %zu (off %zu); surface vertices %zu (off %zu)\n",
                 offset, on.skirt, off.skirt, on.surface, off.surface);
     EXPECT_GT(off.skirt, 20u) << offset;  // the skirt this guards against is there without it
     EXPECT_LE(on.skirt, off.skirt / 4) << offset;
-    // The real surfaces stay: within a voxel of them, at least 99.9 % of the vertices.
-    EXPECT_GE(static_cast<double>(on.surface), 0.999 * static_cast<double>(off.surface)) << offset;
+    // The real surfaces stay: within a voxel of them, at least 99.8 % of the vertices (the
+    // weaker non-confirming updates drop 0.16 % at offset 0.75; the bench's completeness is
+    // unchanged to 1e-4 there).
+    EXPECT_GE(static_cast<double>(on.surface), 0.998 * static_cast<double>(off.surface)) << offset;
   }
 }
 
@@ -141,4 +149,114 @@ TEST(TsdfConfirm, ConfigChecksTheDepthAndNamesItInertWithoutIncidences) {
   EXPECT_EQ(c.inertSettings(), "");
   c.grazing_reach_voxels = 0.0;  // ... and no grazing reach: no incidence is estimated
   EXPECT_NE(c.inertSettings().find("confirm_depth_voxels"), std::string::npos);
+}
+
+// At 5 cm the 4 cm slab is thinner than a voxel. The voxels a voxel or two under it are seen
+// behind the top by the frames above it and free by the frames looking past it under the table.
+// With the confirm depth at 2.5 voxels (12.5 cm) they confirmed and meshed a skirt 6-10 cm below
+// the underside (the accuracy bench's ghosts at 5 cm). Capped at 6.25 cm (the default) most do
+// not; where frames also see them free, equal weights still average to "inside", and a lower
+// unconfirmed_update_weight lets the free space win: no skirt on any lattice phase.
+TEST(TsdfConfirm, AtFiveCentimetresTheSlabGrowsLittleFarSideAndNoneWithTheLowerWeight) {
+  std::size_t capped_total = 0, deep_total = 0;
+  for (const double offset : {0.0, 0.25, 0.5, 0.75}) {
+    TsdfConfig c;
+    c.voxel_size_m = 0.05;
+    const SlabCount capped = tableTopSkirt(c, offset);
+    TsdfConfig uncapped = c;
+    uncapped.confirm_depth_max_m = 0.0;
+    const SlabCount deep = tableTopSkirt(uncapped, offset);
+    TsdfConfig weighted = c;
+    weighted.unconfirmed_update_weight = 0.05;
+    const SlabCount free_wins = tableTopSkirt(weighted, offset);
+    std::printf(
+        "5 cm, offset %.2f voxel: skirt vertices %zu (no cap %zu, weight 0.05 %zu); "
+        "surface %zu (%zu, %zu)\n",
+        offset, capped.skirt, deep.skirt, free_wins.skirt, capped.surface, deep.surface,
+        free_wins.surface);
+    EXPECT_GT(deep.skirt, 20u) << offset;  // what the cap guards against
+    EXPECT_LE(capped.skirt, deep.skirt) << offset;
+    capped_total += capped.skirt;
+    deep_total += deep.skirt;
+    EXPECT_EQ(free_wins.skirt, 0u) << offset;
+    EXPECT_GE(static_cast<double>(capped.surface), 0.99 * static_cast<double>(deep.surface))
+        << offset;
+    EXPECT_GE(static_cast<double>(free_wins.surface), 0.99 * static_cast<double>(deep.surface))
+        << offset;
+  }
+  EXPECT_LE(capped_total, deep_total / 2);  // 71 against 191 when written
+}
+
+// The confirm depth: confirm_depth_voxels voxels, capped at confirm_depth_max_m, never below
+// kConfirmDepthFloorVoxels; 0 = no cap.
+TEST(TsdfConfirm, TheConfirmDepthIsCappedInMetresAboveAFloorInVoxels) {
+  TsdfConfig c;
+  EXPECT_EQ(c.confirm_depth_max_m, 0.05);
+  const std::vector<std::pair<double, double>> voxel_depth = {
+      {0.01, 0.025}, {0.02, 0.05}, {0.03, 0.05}, {0.05, 0.0625}, {0.1, 0.125}};
+  for (const auto& [voxel, depth] : voxel_depth) {
+    c.voxel_size_m = voxel;
+    EXPECT_NEAR(c.confirmDepth(), depth, 1e-12) << voxel;
+  }
+  c.voxel_size_m = 0.05;
+  c.confirm_depth_max_m = 0.0;  // no cap
+  EXPECT_NEAR(c.confirmDepth(), 0.125, 1e-12);
+  c.confirm_depth_voxels = 1.0;  // below the floor: the user's depth
+  c.confirm_depth_max_m = 0.05;
+  EXPECT_NEAR(c.confirmDepth(), 0.05, 1e-12);
+  for (const double bad : {-0.01, 101.0, std::nan(""), HUGE_VAL}) {
+    c.confirm_depth_max_m = bad;
+    EXPECT_NE(c.validate().find("confirm_depth_max_m"), std::string::npos) << bad;
+  }
+  c.confirm_depth_max_m = 0.1;
+  EXPECT_EQ(c.validate(), "");
+  EXPECT_EQ(c.inertSettings(), "");
+  c.confirm_depth_voxels = 0.0;
+  EXPECT_NE(c.inertSettings().find("confirm_depth_max_m"), std::string::npos);
+}
+
+TEST(TsdfConfirm, ConfigChecksTheUnconfirmedWeightAndNamesItInertWithoutConfirmation) {
+  TsdfConfig c;
+  EXPECT_EQ(c.unconfirmed_update_weight, 1.0);
+  for (const double bad : {0.0, -0.1, 1.01, std::nan(""), HUGE_VAL}) {
+    c.unconfirmed_update_weight = bad;
+    EXPECT_NE(c.validate().find("unconfirmed_update_weight"), std::string::npos) << bad;
+  }
+  c.unconfirmed_update_weight = 0.05;
+  EXPECT_EQ(c.validate(), "");
+  EXPECT_EQ(c.inertSettings(), "");
+  c.confirm_depth_voxels = 0.0;  // every update confirms: the weight never applies
+  EXPECT_NE(c.inertSettings().find("unconfirmed_update_weight"), std::string::npos);
+  c.confirm_depth_voxels = TsdfConfig().confirm_depth_voxels;
+  c.edge_guard_rad = 0.0;
+  c.grazing_reach_voxels = 0.0;  // no incidences: no update is deep along a normal
+  EXPECT_NE(c.inertSettings().find("unconfirmed_update_weight"), std::string::npos);
+}
+
+// Along the optical axis of a fronto-parallel wall (incidence 0, no rim near): a voxel a voxel
+// behind the wall confirms at full weight; one three voxels behind (deeper than the confirm
+// depth, within mu) fuses at unconfirmed_update_weight per frame and stays unconfirmed, with the
+// frame's value; 1 fuses it at full weight, still unconfirmed.
+TEST(TsdfConfirm, ANonConfirmingUpdateFusesAtTheLowerWeight) {
+  for (const double scale : {0.05, 0.3, 1.0}) {
+    TsdfConfig c;
+    c.voxel_size_m = 0.02;
+    c.confirm_depth_voxels = 2.5;
+    c.unconfirmed_update_weight = scale;
+    TsdfMap map(c);
+    const PinholeCamera camera = benchmarkCamera();
+    const std::vector<float> depth(static_cast<std::size_t>(camera.width) * camera.height, 1.0f);
+    const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    for (int frame = 0; frame < 2; ++frame) {
+      DepthIntegrator().integrate(&map, depth.data(), camera, pose);
+    }
+    const TsdfVoxel* near = map.voxel({0, 0, 51});  // 2 cm behind the wall at 1 m
+    const TsdfVoxel* deep = map.voxel({0, 0, 53});  // 6 cm behind: deeper than 2.5 voxels
+    ASSERT_NE(near, nullptr);
+    ASSERT_NE(deep, nullptr);
+    EXPECT_FLOAT_EQ(near->weight, 2.0f) << scale;
+    EXPECT_NEAR(near->distance * c.truncation(), -0.02, 1e-4) << scale;
+    EXPECT_FLOAT_EQ(deep->weight, static_cast<float>(-2.0 * scale)) << scale;
+    EXPECT_NEAR(deep->distance * c.truncation(), -0.06, 1e-4) << scale;
+  }
 }

@@ -256,15 +256,18 @@ TEST(Tsdf, EveryVoxelHoldsTheProjectiveUpdateOfItsPixel) {
           expected_w = c.behind_surface_dropoff && sdf < -s ? (mu + sdf) / (mu - s) : 1.0;
         }
         const TsdfVoxel& got = kv.second->voxels[i];
+        // A non-confirming update (checked below to lie deeper than the confirm depth) fuses at
+        // unconfirmed_update_weight times its weight.
+        if (got.weight < 0.0f) expected_w *= c.unconfirmed_update_weight;
         ASSERT_NEAR(got.observedWeight(), expected_w, 1e-4) << "voxel " << voxel.transpose();
         if (expected_w > 0.0) {
           ASSERT_NEAR(got.distance, expected_d, 1e-4) << "voxel " << voxel.transpose();
           ++updated;
         }
-        // Unconfirmed only deeper than confirm_depth_voxels along the normal, so at least that
-        // deep along the ray.
+        // Unconfirmed only deeper than the confirm depth along the normal, so at least that deep
+        // along the ray.
         if (got.weight < 0.0f) {
-          ASSERT_LT(sdf, -c.confirm_depth_voxels * s * (1.0 - 1e-4)) << voxel.transpose();
+          ASSERT_LT(sdf, -c.confirmDepth() * (1.0 - 1e-4)) << voxel.transpose();
           ++unconfirmed;
         }
         ++checked;

@@ -25,6 +25,11 @@
 
 namespace downstream_perception {
 
+/// The least depth (voxels along the normal) confirm_depth_max_m caps the confirm depth to: the
+/// mesh's crossings need the voxel just behind a surface confirmed, and at 1 voxel the room at
+/// 5 cm lost up to 7 % of its surface (docs/tsdf.md).
+constexpr double kConfirmDepthFloorVoxels = 1.25;
+
 struct TsdfConfig {
   double voxel_size_m = 0.02;  ///< voxel edge, m; fixed for the map's life
   /// Truncation distance mu in voxels (mu = truncation_voxels * voxel_size_m); 3-5 is usual.
@@ -49,13 +54,28 @@ struct TsdfConfig {
   /// >= truncation_voxels means no ramp (like behind_surface_dropoff false).
   double behind_surface_dropoff_start_voxels = 1.0;
   /// Depth images: a voxel that frames have only seen deeper than this many voxels behind their
-  /// surface (along the surface's normal, where the pixel's incidence is known) is unconfirmed
-  /// (TsdfVoxel::weight < 0): its values fuse as usual, and the ESDF, the slice and queries read
-  /// it, but the mesh leaves it out until some frame sees it nearer a surface or in front of
-  /// one. Behind a slab thinner than mu seen only from above (a table top), its deep "inside"
-  /// values would otherwise mesh a skirt below the slab's underside where rays beside the slab
-  /// see free space (issue 22; docs/tsdf.md). 0 = off (every update confirms).
+  /// surface (along the surface's normal, where the pixel's incidence is known; at most
+  /// confirm_depth_max_m: confirmDepth()) is unconfirmed (TsdfVoxel::weight < 0): its values fuse
+  /// (at unconfirmed_update_weight), and the ESDF, the slice and queries read it, but the mesh
+  /// leaves it out until some frame sees it nearer a surface or in front of one. Behind a slab
+  /// thinner than mu seen only from above (a table top), its deep "inside" values would otherwise
+  /// mesh a skirt below the slab's underside where rays beside the slab see free space (issue 22;
+  /// docs/tsdf.md). 0 = off (every update confirms).
   double confirm_depth_voxels = 2.5;
+  /// Depth images: caps the confirm depth (m along the normal; 0 = no cap), never below
+  /// kConfirmDepthFloorVoxels: confirmDepth(). At 5 cm voxels 2.5 voxels is 12.5 cm, three times
+  /// a 4 cm table top, and its far side meshed a skirt 6-10 cm under the underside (the accuracy
+  /// bench's ghosts at 5 cm); at 2 cm the cap changes nothing (docs/tsdf.md).
+  double confirm_depth_max_m = 0.05;
+  /// Depth images: an update that does not confirm its voxel (deeper than confirmDepth() behind
+  /// its surface) fuses with its weight times this. Such an update only guesses that the object
+  /// goes on that deep; under a slab thinner than that, frames looking past the slab see the same
+  /// voxels free, and with equal weights the two average to a false "inside" that can mesh a
+  /// skirt below the underside. 0.05 clears the room's 4 cm table top at 5 cm voxels (ghosts
+  /// 0.07-0.12 % -> 0.00-0.02 %) but, like the drop-off, loses surface under large pose noise
+  /// (2 cm / 0.01 rad: completeness 0.83 -> 0.77 at 5 cm, 0.78 -> 0.76 at 2 cm), hence 1 (equal
+  /// weights) by default; lower it for well-localised static scenes (docs/tsdf.md). In (0, 1].
+  double unconfirmed_update_weight = 1.0;
   /// Depth images: how far behind the surface a pixel next to a depth edge (an object's rim)
   /// writes "inside" values. Rays grazing a rim would otherwise write them into the free space
   /// beyond the object's edges (the projective TSDF's ghost surfaces). A depth edge: neighbouring
@@ -148,11 +168,16 @@ struct TsdfConfig {
   double max_block_distance_m = 0.0;
 
   double truncation() const { return truncation_voxels * voxel_size_m; }
+  /// How deep behind its surface (m along the normal) a depth-image update still confirms its
+  /// voxel: confirm_depth_voxels voxels, at most confirm_depth_max_m unless that is less than
+  /// kConfirmDepthFloorVoxels voxels (0 when confirm_depth_voxels is 0: off).
+  double confirmDepth() const;
   /// Empty if valid, else the reason.
   std::string validate() const;
-  /// Settings that differ from their defaults but have no effect under the chosen
-  /// edge_guard_rule (edge_guard_grazing_voxels with kRimDistance, edge_guard_rim_scale with
-  /// kFixedRadius), named with the reason; empty if none. The nodelet warns with it.
+  /// Settings that differ from their defaults but have no effect, named with the reason; empty
+  /// if none. For example edge_guard_grazing_voxels under kRimDistance, the confirm settings
+  /// without incidence estimates, mesh_extrapolate_voxels above truncation_voxels (it meshes as
+  /// truncation_voxels). The nodelet warns with it.
   std::string inertSettings() const;
 };
 
