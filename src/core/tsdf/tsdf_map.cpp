@@ -18,6 +18,21 @@ std::string TsdfConfig::inertSettings() const {
   const char* no_incidences =
       " has no effect without incidence estimates (edge_guard_rule rim_distance with "
       "edge_guard_rad > 0, or grazing_reach_voxels > 0)";
+  // The confirm rule's own settings (the first one changed) do nothing while the rule is off
+  // or has no incidences to read.
+  const char* confirm_setting = nullptr;
+  double confirm_value = 0.0;
+  if (confirm_depth_max_m != defaults.confirm_depth_max_m) {
+    confirm_setting = "confirm_depth_max_m";
+    confirm_value = confirm_depth_max_m;
+  } else if (unconfirmed_update_weight != defaults.unconfirmed_update_weight) {
+    confirm_setting = "unconfirmed_update_weight";
+    confirm_value = unconfirmed_update_weight;
+  }
+  const char* confirm_inert =
+      !(confirm_depth_voxels > 0.0)
+          ? " has no effect with confirm_depth_voxels 0 (every update confirms)"
+          : (estimates_incidences ? nullptr : no_incidences);
   if (edge_guard_rule == EdgeGuardRule::kRimDistance &&
       edge_guard_grazing_voxels != defaults.edge_guard_grazing_voxels) {
     why << "edge_guard_grazing_voxels " << edge_guard_grazing_voxels
@@ -30,18 +45,8 @@ std::string TsdfConfig::inertSettings() const {
   } else if (confirm_depth_voxels != defaults.confirm_depth_voxels && confirm_depth_voxels > 0.0 &&
              !estimates_incidences) {
     why << "confirm_depth_voxels " << confirm_depth_voxels << no_incidences;
-  } else if (confirm_depth_max_m != defaults.confirm_depth_max_m &&
-             (!(confirm_depth_voxels > 0.0) || !estimates_incidences)) {
-    why << "confirm_depth_max_m " << confirm_depth_max_m
-        << (confirm_depth_voxels > 0.0
-                ? no_incidences
-                : " has no effect with confirm_depth_voxels 0 (every update confirms)");
-  } else if (unconfirmed_update_weight != defaults.unconfirmed_update_weight &&
-             (!(confirm_depth_voxels > 0.0) || !estimates_incidences)) {
-    why << "unconfirmed_update_weight " << unconfirmed_update_weight
-        << (confirm_depth_voxels > 0.0
-                ? no_incidences
-                : " has no effect with confirm_depth_voxels 0 (every update confirms)");
+  } else if (confirm_setting != nullptr && confirm_inert != nullptr) {
+    why << confirm_setting << " " << confirm_value << confirm_inert;
   } else if (incidence_window_radius_px != defaults.incidence_window_radius_px &&
              incidence_window_radius_px > 0 && !estimates_incidences) {
     why << "incidence_window_radius_px " << incidence_window_radius_px << no_incidences;
