@@ -15,6 +15,12 @@ if ! "$venv/bin/python" -c "import motmetrics" 2> /dev/null; then
     exit 0
   fi
 fi
+# pytest-xdist: the sanitized pytests run in two processes (make test-sanitize); without it they
+# run in one, only slower.
+if ! "$venv/bin/python" -c "import xdist" 2> /dev/null; then
+  "$venv/bin/pip" install -q "pytest-xdist==3.8.0" ||
+    echo "python: WARNING: no pytest-xdist from PyPI; make test-sanitize runs its pytests serially" >&2
+fi
 echo "python: $venv ($("$venv/bin/python" -c 'import motmetrics; print("motmetrics", motmetrics.__version__)'))"
 
 # Build-time only: pybind11 >= 2.12 from PyPI, so that the compiled core exchanges arrays with

@@ -23,11 +23,19 @@ mkdir -p "$RESULTS"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 status=0
 
-# gtests: leaks in our own C++ are real, so LeakSanitizer stays on.
-ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
-  ./devel/lib/downstream_perception/test_core --gtest_output="xml:$RESULTS/gtest-test_core.xml" \
-  > "$RESULTS/gtest.log" 2>&1 || status=1
-grep -E '^\[  (PASSED|FAILED) ' "$RESULTS/gtest.log" || true
+# gtests: leaks in our own C++ are real, so LeakSanitizer stays on. Two shards run side by side
+# (gtest's own sharding: each test in exactly one shard), one per core: instrumented, the TSDF
+# accuracy tests take minutes each and a single process left a core idle for 20 minutes.
+shards=2
+pids=()
+for ((i = 0; i < shards; ++i)); do
+  GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
+    ./devel/lib/downstream_perception/test_core \
+    --gtest_output="xml:$RESULTS/gtest-test_core-$i.xml" > "$RESULTS/gtest-$i.log" 2>&1 &
+  pids+=($!)
+done
+for pid in "${pids[@]}"; do wait "$pid" || status=1; done
+grep -E '^\[  (PASSED|FAILED) ' "$RESULTS"/gtest-*.log || true
 
 # pytests: Python is not instrumented, so the runtime is preloaded; CPython leaks by design.
 source_workspace_at() {
@@ -55,14 +63,18 @@ if [[ "$module" != "$SAN_WS/devel/"* ]] || ! grep -q __asan_init <<< "$symbols";
   exit 1
 fi
 echo "sanitize: python imports $module (instrumented)"
-(cd "$REPO" && DP_PARTIAL_BUILD=1 LD_PRELOAD="$preload" "$python" -m pytest -q -p no:cacheprovider test/pytest \
-  --junitxml="$RESULTS/pytest.xml") > "$RESULTS/pytest.log" 2>&1 || status=1
+# Two workers when pytest-xdist is there (tools/python_venv.sh): one per core.
+workers=()
+"$python" -c "import xdist" 2> /dev/null && workers=(-n 2)
+(cd "$REPO" && DP_PARTIAL_BUILD=1 LD_PRELOAD="$preload" "$python" -m pytest -q -p no:cacheprovider \
+  "${workers[@]}" test/pytest --junitxml="$RESULTS/pytest.xml") > "$RESULTS/pytest.log" 2>&1 || status=1
 tail -1 "$RESULTS/pytest.log"
 
 summary_status=0
 python3 "$REPO/tools/test_summary.py" "$RESULTS" --label sanitize \
-  --expect gtest-test_core.xml --expect pytest.xml \
-  --sanitizer-log "$RESULTS/gtest.log" --sanitizer-log "$RESULTS/pytest.log" || summary_status=$?
+  --expect gtest-test_core-0.xml --expect gtest-test_core-1.xml --expect pytest.xml \
+  --sanitizer-log "$RESULTS/gtest-0.log" --sanitizer-log "$RESULTS/gtest-1.log" \
+  --sanitizer-log "$RESULTS/pytest.log" || summary_status=$?
 if ((status != 0 && summary_status == 0)); then
   echo "sanitize: a test process failed without a failing test case (see $RESULTS/*.log)"
   summary_status=1
