@@ -9,10 +9,11 @@ cases: clean; 5 mm Gaussian depth noise; that plus pose noise (frames rendered a
 integrated at a perturbed one: 5 mm / 0.2 deg, or 2 cm / 0.01 rad per axis). Seeds are fixed
 per (scene, offset), so every integrator gets the very same frames and poses in the same run.
 Integrators: ours (downstream_perception Tsdf, by default with edge_guard_rad 0.0075;
---edge-guard adds other values), Open3D legacy ScalableTSDFVolume and tensor VoxelBlockGrid on
-the CPU (when open3d imports). All at a truncation of 4 voxels. Each mesh, welded (identical
-vertices merged), is scored with tsdf_eval.score_mesh against the analytic scene: the observed
-surface is what the clean frames saw.
+--edge-guard adds other values; --ours adds variants with other TsdfConfig values), Open3D
+legacy ScalableTSDFVolume and tensor VoxelBlockGrid on the CPU (when open3d imports). All at a
+truncation of 4 voxels. Each mesh, welded (identical vertices merged), is scored with
+tsdf_eval.score_mesh against the analytic scene: the observed surface is what the clean frames
+saw.
 
 Output: a markdown table per (image, voxel, noise, integrator) of the median (min-max) over
 scenes x offsets of mean and p95 |SDF| at the vertices (mm), ghosts (% of vertices more than a
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import itertools
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -83,13 +85,48 @@ Mesh = tuple[np.ndarray, np.ndarray]  # vertices (V, 3), triangles (T, 3)
 Integrator = Callable[[Sequence[np.ndarray], Sequence[np.ndarray], Any, float], Mesh]
 
 
+Settings = tuple[tuple[str, float], ...]  # TsdfConfig keys and values, in order
+
+
+def parse_settings(text: str) -> Settings:
+    """'key=value,key=value' (TsdfConfig numeric or boolean keys; 'default' or '' for none) ->
+    settings; ValueError naming an unknown key or a value that is no number."""
+    import downstream_perception as dp
+
+    if text in ("", "default"):
+        return ()
+    config = dp.TsdfConfig()
+    settings = []
+    for item in text.split(","):
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or key.startswith("_") or not hasattr(config, key):
+            raise ValueError(f"'{item}': not key=value with a TsdfConfig key")
+        current = getattr(config, key)
+        if not isinstance(current, bool | int | float):
+            raise ValueError(f"'{item}': {key} is no number or boolean")
+        if isinstance(current, bool):
+            if value not in ("true", "false"):
+                raise ValueError(f"'{item}': {key} is true or false")
+            settings.append((key, float(value == "true")))
+        else:
+            settings.append((key, float(value)))
+    return tuple(settings)
+
+
+def settings_name(settings: Settings) -> str:
+    return "".join(f", {key} {value:g}" for key, value in settings)
+
+
 def ours(
     edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD,
     dropoff: bool | None = None,
     extrapolate_voxels: float | None = None,
+    settings: Settings = (),
 ) -> Integrator:
     """Ours at this edge guard; dropoff: behind_surface_dropoff, extrapolate_voxels:
-    mesh_extrapolate_voxels (None: the defaults)."""
+    mesh_extrapolate_voxels (None: the defaults); settings: further TsdfConfig values, set last
+    (parse_settings)."""
 
     def integrate(
         depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any, voxel_m: float
@@ -104,6 +141,9 @@ def ours(
             config.behind_surface_dropoff = dropoff
         if extrapolate_voxels is not None:
             config.mesh_extrapolate_voxels = extrapolate_voxels
+        for key, value in settings:
+            current = getattr(config, key)
+            setattr(config, key, bool(value) if isinstance(current, bool) else type(current)(value))
         tsdf = dp.Tsdf(config)
         pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
         for depth, pose in zip(depths, poses, strict=True):
@@ -197,20 +237,22 @@ def integrators(
     open3d: bool = True,
     legacy_native_lattice: bool = False,
     extrapolations: Sequence[float | None] = (None,),
+    variants: Sequence[Settings] = ((),),
 ) -> dict[str, Integrator]:
-    """Ours at each edge guard, behind_surface_dropoff and mesh_extrapolate_voxels setting
-    (None: the default; the defaults' one named plainly), then Open3D's when it imports (and
-    `open3d`); legacy on our lattice unless legacy_native_lattice."""
+    """Ours at each edge guard, behind_surface_dropoff, mesh_extrapolate_voxels setting
+    (None: the default) and variant of further settings (parse_settings; the defaults' one
+    named plainly), then Open3D's when it imports (and `open3d`); legacy on our lattice unless
+    legacy_native_lattice."""
     found: dict[str, Integrator] = {}
-    for rad in edge_guards:
-        for dropoff in dropoffs:
-            for voxels in extrapolations:
-                name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
-                if dropoff is not None:
-                    name += f", behind_surface_dropoff {'on' if dropoff else 'off'}"
-                if voxels is not None:
-                    name += f", mesh_extrapolate_voxels {voxels:g}"
-                found[name] = ours(rad, dropoff, voxels)
+    for rad, dropoff, voxels, settings in itertools.product(
+        edge_guards, dropoffs, extrapolations, variants
+    ):
+        name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
+        if dropoff is not None:
+            name += f", behind_surface_dropoff {'on' if dropoff else 'off'}"
+        if voxels is not None:
+            name += f", mesh_extrapolate_voxels {voxels:g}"
+        found[name + settings_name(settings)] = ours(rad, dropoff, voxels, settings)
     if not open3d:
         return found
     try:
@@ -279,12 +321,15 @@ def run(
     open3d: bool = True,
     legacy_native_lattice: bool = False,
     extrapolations: Sequence[float | None] = (None,),
+    variants: Sequence[Settings] = ((),),
 ) -> list[Score]:
     from downstream_perception.sim.depth_camera import DepthCamera
     from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
     from downstream_perception.tsdf_eval import observed_samples
 
-    chosen = integrators(edge_guards, dropoffs, open3d, legacy_native_lattice, extrapolations)
+    chosen = integrators(
+        edge_guards, dropoffs, open3d, legacy_native_lattice, extrapolations, variants
+    )
     cameras = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
@@ -480,6 +525,14 @@ def main() -> None:
         default="default",
         help="comma-separated mesh_extrapolate_voxels settings for ours: default or voxels",
     )
+    parser.add_argument(
+        "--ours",
+        action="append",
+        default=None,
+        help="a variant of ours: comma-separated TsdfConfig key=value (e.g. "
+        "unconfirmed_update_weight=0.05,confirm_depth_max_m=0), or 'default'; repeat for more "
+        "(default: one, the defaults)",
+    )
     parser.add_argument("--no-open3d", action="store_true", help="ours only")
     parser.add_argument(
         "--legacy-lattice",
@@ -505,6 +558,10 @@ def main() -> None:
     if args.quick:
         scenes, configs, frames = scenes[:2], [("320x240", 0.05)], 8
         offsets, scale = (0.0, 0.5), 0.5
+    try:
+        variants = [parse_settings(v) for v in (args.ours or ["default"])]
+    except ValueError as error:
+        parser.error(str(error))
     t0 = time.perf_counter()
     settings = {"default": None, "on": True, "off": False}
     dropoffs = [settings[v] for v in args.dropoff.split(",")]
@@ -522,6 +579,7 @@ def main() -> None:
         extrapolations=[
             None if v == "default" else float(v) for v in args.mesh_extrapolate.split(",")
         ],
+        variants=variants,
     )
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

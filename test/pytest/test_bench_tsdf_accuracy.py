@@ -178,3 +178,41 @@ def test_open3d_legacy_runs_on_our_lattice(bench: Any, monkeypatch: pytest.Monke
     native, _ = bench.open3d_legacy([depth], [pose], cam, 0.02, native_lattice=True)
     np.testing.assert_allclose(native, [[0.01, 0.01, 0.01]], atol=1e-12)
     np.testing.assert_allclose(extrinsics[1], np.linalg.inv(pose), atol=1e-12)
+
+
+def test_variants_of_ours_set_their_tsdf_config_values(
+    bench: Any, room: tuple, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import downstream_perception as dp
+
+    settings = bench.parse_settings("unconfirmed_update_weight=0.05,carve_free_space=true")
+    assert settings == (("unconfirmed_update_weight", 0.05), ("carve_free_space", 1.0))
+    assert bench.parse_settings("default") == ()
+    for bad in ("no_such_key=1", "unconfirmed_update_weight", "carve_free_space=1", "_x=1"):
+        with pytest.raises(ValueError):
+            bench.parse_settings(bad)
+    with pytest.raises(ValueError):
+        bench.parse_settings("unconfirmed_update_weight=heavy")
+    names = list(
+        bench.integrators([bench.DEFAULT_EDGE_GUARD_RAD], variants=[(), settings], open3d=False)
+    )
+    assert names == ["ours", "ours, unconfirmed_update_weight 0.05, carve_free_space 1"]
+    # The values reach the map's config (after the bench's own: truncation_voxels too).
+    seen = []
+    real = dp.Tsdf
+
+    def recording(config: Any) -> Any:
+        seen.append(config)
+        return real(config)
+
+    monkeypatch.setattr(dp, "Tsdf", recording)
+    cam, scene, poses, depths, observed = room
+    override = settings + (("truncation_voxels", 3.0),)
+    row = bench.score_case(bench.ours(settings=override), scene, cam, depths, poses, 0.05, observed)
+    assert row["vertices"] > 1000
+    assert seen[-1].unconfirmed_update_weight == pytest.approx(0.05)
+    assert seen[-1].carve_free_space is True
+    assert seen[-1].truncation_voxels == 3.0
+    bench.ours()(depths[:1], poses[:1], cam, 0.05)
+    assert seen[-1].unconfirmed_update_weight == 1.0
+    assert seen[-1].truncation_voxels == bench.TRUNCATION_VOXELS
