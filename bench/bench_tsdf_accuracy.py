@@ -85,18 +85,20 @@ Mesh = tuple[np.ndarray, np.ndarray]  # vertices (V, 3), triangles (T, 3)
 Integrator = Callable[[Sequence[np.ndarray], Sequence[np.ndarray], Any, float], Mesh]
 
 
-Settings = tuple[tuple[str, float], ...]  # TsdfConfig keys and values, in order
+Setting = tuple[str, float | bool]  # a TsdfConfig key and its value
+Settings = tuple[Setting, ...]  # set in this order
 
 
 def parse_settings(text: str) -> Settings:
     """'key=value,key=value' (TsdfConfig numeric or boolean keys; 'default' or '' for none) ->
-    settings; ValueError naming an unknown key or a value that is no number."""
+    settings, each value typed as its key's; ValueError naming an unknown key or a value that is
+    no number."""
     import downstream_perception as dp
 
     if text in ("", "default"):
         return ()
     config = dp.TsdfConfig()
-    settings = []
+    settings: list[Setting] = []
     for item in text.split(","):
         key, sep, value = item.partition("=")
         key = key.strip()
@@ -108,25 +110,39 @@ def parse_settings(text: str) -> Settings:
         if isinstance(current, bool):
             if value not in ("true", "false"):
                 raise ValueError(f"'{item}': {key} is true or false")
-            settings.append((key, float(value == "true")))
-        else:
-            settings.append((key, float(value)))
+            settings.append((key, value == "true"))
+            continue
+        try:
+            number = float(value)
+        except ValueError:
+            raise ValueError(f"'{item}': {key} takes a number") from None
+        if isinstance(current, int) and not number.is_integer():
+            raise ValueError(f"'{item}': {key} takes a whole number")
+        settings.append((key, type(current)(number)))
     return tuple(settings)
 
 
 def settings_name(settings: Settings) -> str:
-    return "".join(f", {key} {value:g}" for key, value in settings)
+    return "".join(
+        f", {key} {('on' if value else 'off') if isinstance(value, bool) else f'{value:g}'}"
+        for key, value in settings
+    )
 
 
-def ours(
-    edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD,
-    dropoff: bool | None = None,
-    extrapolate_voxels: float | None = None,
-    settings: Settings = (),
-) -> Integrator:
-    """Ours at this edge guard; dropoff: behind_surface_dropoff, extrapolate_voxels:
-    mesh_extrapolate_voxels (None: the defaults); settings: further TsdfConfig values, set last
-    (parse_settings)."""
+def crossed_variants(
+    variants: Sequence[Settings], dropoffs: Sequence[Settings], extrapolations: Sequence[Settings]
+) -> list[Settings]:
+    """Every dropoff and extrapolation setting (--dropoff, --mesh-extrapolate) with every
+    variant (--ours), in the order the names were always given."""
+    return [
+        dropoff + extrapolation + variant
+        for dropoff, extrapolation, variant in itertools.product(dropoffs, extrapolations, variants)
+    ]
+
+
+def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD, settings: Settings = ()) -> Integrator:
+    """Ours at this edge guard; settings: further TsdfConfig values (parse_settings), set after
+    the bench's own."""
 
     def integrate(
         depths: Sequence[np.ndarray], poses: Sequence[np.ndarray], cam: Any, voxel_m: float
@@ -137,13 +153,8 @@ def ours(
         config.voxel_size_m = voxel_m
         config.truncation_voxels = TRUNCATION_VOXELS
         config.edge_guard_rad = edge_guard_rad
-        if dropoff is not None:
-            config.behind_surface_dropoff = dropoff
-        if extrapolate_voxels is not None:
-            config.mesh_extrapolate_voxels = extrapolate_voxels
         for key, value in settings:
-            current = getattr(config, key)
-            setattr(config, key, bool(value) if isinstance(current, bool) else type(current)(value))
+            setattr(config, key, value)
         tsdf = dp.Tsdf(config)
         pinhole = dp.PinholeCamera(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
         for depth, pose in zip(depths, poses, strict=True):
@@ -233,26 +244,17 @@ def open3d_tensor(
 
 def integrators(
     edge_guards: Sequence[float],
-    dropoffs: Sequence[bool | None] = (None,),
     open3d: bool = True,
     legacy_native_lattice: bool = False,
-    extrapolations: Sequence[float | None] = (None,),
     variants: Sequence[Settings] = ((),),
 ) -> dict[str, Integrator]:
-    """Ours at each edge guard, behind_surface_dropoff, mesh_extrapolate_voxels setting
-    (None: the default) and variant of further settings (parse_settings; the defaults' one
-    named plainly), then Open3D's when it imports (and `open3d`); legacy on our lattice unless
+    """Ours at each edge guard and variant of settings (parse_settings; the defaults' one named
+    plainly), then Open3D's when it imports (and `open3d`); legacy on our lattice unless
     legacy_native_lattice."""
     found: dict[str, Integrator] = {}
-    for rad, dropoff, voxels, settings in itertools.product(
-        edge_guards, dropoffs, extrapolations, variants
-    ):
+    for rad, settings in itertools.product(edge_guards, variants):
         name = "ours" if rad == DEFAULT_EDGE_GUARD_RAD else f"ours, edge_guard_rad {rad:g}"
-        if dropoff is not None:
-            name += f", behind_surface_dropoff {'on' if dropoff else 'off'}"
-        if voxels is not None:
-            name += f", mesh_extrapolate_voxels {voxels:g}"
-        found[name + settings_name(settings)] = ours(rad, dropoff, voxels, settings)
+        found[name + settings_name(settings)] = ours(rad, settings)
     if not open3d:
         return found
     try:
@@ -317,19 +319,15 @@ def run(
     frames: int,
     camera_scale: float = 1.0,
     log: Callable[[str], None] = print,
-    dropoffs: Sequence[bool | None] = (None,),
     open3d: bool = True,
     legacy_native_lattice: bool = False,
-    extrapolations: Sequence[float | None] = (None,),
     variants: Sequence[Settings] = ((),),
 ) -> list[Score]:
     from downstream_perception.sim.depth_camera import DepthCamera
     from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
     from downstream_perception.tsdf_eval import observed_samples
 
-    chosen = integrators(
-        edge_guards, dropoffs, open3d, legacy_native_lattice, extrapolations, variants
-    )
+    chosen = integrators(edge_guards, open3d, legacy_native_lattice, variants)
     cameras = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
@@ -518,12 +516,14 @@ def main() -> None:
     parser.add_argument(
         "--dropoff",
         default="default",
-        help="comma-separated behind_surface_dropoff settings for ours: default, on, off",
+        help="comma-separated behind_surface_dropoff settings for ours: default, on, off "
+        "(crossed with every --ours variant)",
     )
     parser.add_argument(
         "--mesh-extrapolate",
         default="default",
-        help="comma-separated mesh_extrapolate_voxels settings for ours: default or voxels",
+        help="comma-separated mesh_extrapolate_voxels settings for ours: default or voxels "
+        "(crossed with every --ours variant)",
     )
     parser.add_argument(
         "--ours",
@@ -558,13 +558,23 @@ def main() -> None:
     if args.quick:
         scenes, configs, frames = scenes[:2], [("320x240", 0.05)], 8
         offsets, scale = (0.0, 0.5), 0.5
+    switch = {"default": "", "on": "behind_surface_dropoff=true"}
+    switch["off"] = "behind_surface_dropoff=false"
     try:
-        variants = [parse_settings(v) for v in (args.ours or ["default"])]
+        variants = crossed_variants(
+            [parse_settings(v) for v in (args.ours or ["default"])],
+            [
+                parse_settings(switch.get(v, f"behind_surface_dropoff={v}"))
+                for v in args.dropoff.split(",")
+            ],
+            [
+                parse_settings("" if v == "default" else f"mesh_extrapolate_voxels={v}")
+                for v in args.mesh_extrapolate.split(",")
+            ],
+        )
     except ValueError as error:
         parser.error(str(error))
     t0 = time.perf_counter()
-    settings = {"default": None, "on": True, "off": False}
-    dropoffs = [settings[v] for v in args.dropoff.split(",")]
     scores = run(
         scenes,
         offsets,
@@ -573,12 +583,8 @@ def main() -> None:
         edge_guards,
         frames,
         scale,
-        dropoffs=dropoffs,
         open3d=not args.no_open3d,
         legacy_native_lattice=args.legacy_lattice == "native",
-        extrapolations=[
-            None if v == "default" else float(v) for v in args.mesh_extrapolate.split(",")
-        ],
         variants=variants,
     )
     if args.json:

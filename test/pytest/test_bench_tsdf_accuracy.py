@@ -186,9 +186,12 @@ def test_variants_of_ours_set_their_tsdf_config_values(
     import downstream_perception as dp
 
     settings = bench.parse_settings("unconfirmed_update_weight=0.05,carve_free_space=true")
-    assert settings == (("unconfirmed_update_weight", 0.05), ("carve_free_space", 1.0))
+    assert settings == (("unconfirmed_update_weight", 0.05), ("carve_free_space", True))
+    assert settings[1][1] is True  # typed as the key is, not 1.0
+    assert bench.parse_settings("incidence_window_radius_px=3")[0][1].__class__ is int
     assert bench.parse_settings("default") == ()
-    for bad in ("no_such_key=1", "unconfirmed_update_weight", "carve_free_space=1", "_x=1"):
+    bad_ones = ("no_such_key=1", "unconfirmed_update_weight", "carve_free_space=1", "_x=1")
+    for bad in (*bad_ones, "incidence_window_radius_px=2.5"):
         with pytest.raises(ValueError):
             bench.parse_settings(bad)
     with pytest.raises(ValueError):
@@ -196,7 +199,17 @@ def test_variants_of_ours_set_their_tsdf_config_values(
     names = list(
         bench.integrators([bench.DEFAULT_EDGE_GUARD_RAD], variants=[(), settings], open3d=False)
     )
-    assert names == ["ours", "ours, unconfirmed_update_weight 0.05, carve_free_space 1"]
+    assert names == ["ours", "ours, unconfirmed_update_weight 0.05, carve_free_space on"]
+    # --dropoff and --mesh-extrapolate are settings too, crossed with every variant.
+    off, zero = (("behind_surface_dropoff", False),), (("mesh_extrapolate_voxels", 0.0),)
+    crossed = bench.crossed_variants([(), settings], [(), off], [zero])
+    assert [bench.settings_name(v) for v in crossed] == [
+        ", mesh_extrapolate_voxels 0",
+        ", mesh_extrapolate_voxels 0, unconfirmed_update_weight 0.05, carve_free_space on",
+        ", behind_surface_dropoff off, mesh_extrapolate_voxels 0",
+        ", behind_surface_dropoff off, mesh_extrapolate_voxels 0, unconfirmed_update_weight 0.05"
+        ", carve_free_space on",
+    ]
     # The values reach the map's config (after the bench's own: truncation_voxels too).
     seen = []
     real = dp.Tsdf
