@@ -137,8 +137,9 @@ TsdfConfig withConfirmDepth(double confirm_depth_voxels) {
 
 TEST(TsdfConfirm, TheTableTopGrowsNoSkirtBelowItsUnderside) {
   for (const double offset : {0.0, 0.75}) {
-    const RoomFrames frames = roomFrames(offset * 0.02);
-    const SlabCount off = tableTopSkirt(withConfirmDepth(0.0), frames);
+    const TsdfConfig unconfirmed = withConfirmDepth(0.0);
+    const RoomFrames frames = roomFrames(offset * unconfirmed.voxel_size_m);
+    const SlabCount off = tableTopSkirt(unconfirmed, frames);
     const SlabCount on = tableTopSkirt(withConfirmDepth(TsdfConfig().confirm_depth_voxels), frames);
     std::printf("offset %.2f voxel: skirt vertices %zu (off %zu); surface vertices %zu (off %zu)\n",
                 offset, on.skirt, off.skirt, on.surface, off.surface);
