@@ -67,9 +67,18 @@ echo "sanitize: python imports $module (instrumented)"
 # Two workers when pytest-xdist is there (tools/python_venv.sh): one per core.
 workers=()
 "$python" -c "import xdist" 2> /dev/null && workers=(-n 2)
-(cd "$REPO" && DP_PARTIAL_BUILD=1 LD_PRELOAD="$preload" "$python" -m pytest -q -p no:cacheprovider \
+# pytest captures each test's stderr in a file of its own, lost when a sanitizer aborts the
+# process (the test still fails: the worker crashes); so reports go to files (one per process, the
+# pid appended) and are added to pytest.log, where they count.
+reports="$RESULTS/pytest-sanitizer"
+rm -f "$reports".*
+(cd "$REPO" && DP_PARTIAL_BUILD=1 LD_PRELOAD="$preload" ASAN_OPTIONS="$ASAN_OPTIONS:log_path=$reports" \
+  UBSAN_OPTIONS="$UBSAN_OPTIONS:log_path=$reports" "$python" -m pytest -q -p no:cacheprovider \
   "${workers[@]}" test/pytest --junitxml="$RESULTS/pytest.xml") > "$RESULTS/pytest.log" 2>&1 || status=1
 tail -1 "$RESULTS/pytest.log"
+for report in "$reports".*; do
+  if [[ -f "$report" ]]; then cat "$report" >> "$RESULTS/pytest.log"; fi
+done
 
 summary_status=0
 python3 "$REPO/tools/test_summary.py" "$RESULTS" --label sanitize \
