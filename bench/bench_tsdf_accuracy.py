@@ -558,13 +558,14 @@ def main() -> None:
     if args.quick:
         scenes, configs, frames = scenes[:2], [("320x240", 0.05)], 8
         offsets, scale = (0.0, 0.5), 0.5
-    switch = {"default": "", "on": "behind_surface_dropoff=true"}
-    switch["off"] = "behind_surface_dropoff=false"
+    dropoff = {"on": "true", "off": "false"}  # other words reach parse_settings, which refuses them
     try:
         variants = crossed_variants(
             [parse_settings(v) for v in (args.ours or ["default"])],
             [
-                parse_settings(switch.get(v, f"behind_surface_dropoff={v}"))
+                parse_settings(
+                    "" if v == "default" else f"behind_surface_dropoff={dropoff.get(v, v)}"
+                )
                 for v in args.dropoff.split(",")
             ],
             [

@@ -71,7 +71,6 @@ workers=()
 # process (the test still fails: the worker crashes); so reports go to files (one per process, the
 # pid appended) and are added to pytest.log, where they count.
 reports="$RESULTS/pytest-sanitizer"
-rm -f "$reports".*
 (cd "$REPO" && DP_PARTIAL_BUILD=1 LD_PRELOAD="$preload" ASAN_OPTIONS="$ASAN_OPTIONS:log_path=$reports" \
   UBSAN_OPTIONS="$UBSAN_OPTIONS:log_path=$reports" "$python" -m pytest -q -p no:cacheprovider \
   "${workers[@]}" test/pytest --junitxml="$RESULTS/pytest.xml") > "$RESULTS/pytest.log" 2>&1 || status=1
