@@ -140,6 +140,16 @@ def crossed_variants(
     ]
 
 
+def flag_settings(words: str, key: str, aliases: dict[str, str] | None = None) -> list[Settings]:
+    """A comma-separated flag's words ('default': the default) -> one setting of key each; a word
+    may stand for a value (aliases); parse_settings refuses a bad one."""
+    aliases = aliases or {}
+    return [
+        parse_settings("" if word == "default" else f"{key}={aliases.get(word, word)}")
+        for word in words.split(",")
+    ]
+
+
 def ours(edge_guard_rad: float = DEFAULT_EDGE_GUARD_RAD, settings: Settings = ()) -> Integrator:
     """Ours at this edge guard; settings: further TsdfConfig values (parse_settings), set after
     the bench's own."""
@@ -558,20 +568,11 @@ def main() -> None:
     if args.quick:
         scenes, configs, frames = scenes[:2], [("320x240", 0.05)], 8
         offsets, scale = (0.0, 0.5), 0.5
-    dropoff = {"on": "true", "off": "false"}  # other words reach parse_settings, which refuses them
     try:
         variants = crossed_variants(
             [parse_settings(v) for v in (args.ours or ["default"])],
-            [
-                parse_settings(
-                    "" if v == "default" else f"behind_surface_dropoff={dropoff.get(v, v)}"
-                )
-                for v in args.dropoff.split(",")
-            ],
-            [
-                parse_settings("" if v == "default" else f"mesh_extrapolate_voxels={v}")
-                for v in args.mesh_extrapolate.split(",")
-            ],
+            flag_settings(args.dropoff, "behind_surface_dropoff", {"on": "true", "off": "false"}),
+            flag_settings(args.mesh_extrapolate, "mesh_extrapolate_voxels"),
         )
     except ValueError as error:
         parser.error(str(error))
