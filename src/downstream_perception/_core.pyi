@@ -477,6 +477,13 @@ class TsdfConfig:
     @unconfirmed_update_weight.setter
     def unconfirmed_update_weight(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
     @property
+    def far_free_guess_weight(self) -> float:
+        """
+        Depth images: an update deeper than the confirm depth on a voxel that reads free and that some frame saw more than mu in front of its surface fuses with its weight times this, and a far-free update of an unconfirmed voxel with its weight over this: free space seen beats a guess, in either order. In (0, 1]; 1 = off.
+        """
+    @far_free_guess_weight.setter
+    def far_free_guess_weight(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None: ...
+    @property
     def carve_free_space(self) -> bool:
         """
         Update the voxels along the whole ray from the sensor, not only the truncation band: an object that moved away is erased where its free space is seen again (voxblox's voxel carving). Off by default: it allocates blocks for all the free space in view, so memory and time grow with the range. Carving stays inside the camera's view frustum up to max_depth_m (PinholeCamera::validate refuses intrinsics whose frustum is absurdly wide or off-axis).

@@ -258,6 +258,12 @@ void bindTsdf(py::module& m) {
                      "(it does not confirm its voxel) fuses with its weight times this, so frames "
                      "that see the voxel free outweigh it (no skirt under a thin slab seen from "
                      "above). In (0, 1]; 1 = equal weights.")
+      .def_readwrite("far_free_guess_weight", &TsdfConfig::far_free_guess_weight,
+                     "Depth images: an update deeper than the confirm depth on a voxel that reads "
+                     "free and that some frame saw more than mu in front of its surface fuses "
+                     "with its weight times this, and a far-free update of an unconfirmed voxel "
+                     "with its weight over this: free space seen beats a guess, in either order. "
+                     "In (0, 1]; 1 = off.")
       .def_readwrite("edge_guard_rule", &TsdfConfig::edge_guard_rule,
                      "Depth images: how deep behind the surface pixels next to a depth edge (an "
                      "object's rim) write inside values (rays grazing a rim would otherwise "

@@ -1261,6 +1261,7 @@ def tsdf_config_args(g: Gen) -> dict[str, Any]:
         "confirm_depth_voxels": g.f(0, 5, 0.1),
         "confirm_depth_max_m": g.f(0, 0.2, 0.1),
         "unconfirmed_update_weight": g.f(0.01, 1, 0.1),
+        "far_free_guess_weight": g.f(0.01, 1, 0.1),
         "incidence_window_radius_px": g.i(0, 8, 0.1),
         "edge_guard_rad": g.f(0, 0.01, 0.1),
         "edge_guard_near_side_only": g.b(),

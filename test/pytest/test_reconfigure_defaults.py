@@ -138,6 +138,7 @@ def test_tsdf_defaults_match_tsdf_config_and_yaml() -> None:
         "confirm_depth_voxels",
         "confirm_depth_max_m",
         "unconfirmed_update_weight",
+        "far_free_guess_weight",
         "incidence_window_radius_px",
         "edge_guard_rad",
         "edge_guard_near_side_only",

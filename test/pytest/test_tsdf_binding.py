@@ -338,31 +338,40 @@ def test_unconfirmed_voxels_keep_the_table_tops_underside_clean() -> None:
     assert scores[2.5].completeness > scores[0.0].completeness - 0.0005
 
 
-def test_coarse_voxels_grow_less_far_side_under_the_table_top() -> None:
+def test_coarse_voxels_grow_no_far_side_under_the_table_top() -> None:
     # At 5 cm the 4 cm table top is thinner than a voxel: with the confirm depth at 2.5 voxels
     # (12.5 cm, no cap) the voxels under it meshed a skirt 6-10 cm below the underside (ghosts
-    # over a voxel off every surface). The cap (default) removes most of it; a lower
-    # unconfirmed_update_weight (not the default: it loses surface under large pose noise) the
-    # rest, where frames also see those voxels free.
+    # over a voxel off every surface). The cap removes most of it; far_free_guess_weight (the
+    # default since 2026-12-07) the rest, where frames saw those voxels far free, as a lower
+    # unconfirmed_update_weight (not the default: it loses surface under large pose noise) does
+    # everywhere.
     c = dp.TsdfConfig()
     assert c.confirm_depth_max_m == 0.05 and c.unconfirmed_update_weight == 1.0
+    assert c.far_free_guess_weight == pytest.approx(0.05)
     assert c.confirm_depth() == pytest.approx(0.05)  # 2 cm: 2.5 voxels, under the cap
     c.voxel_size_m = 0.05
     assert c.confirm_depth() == pytest.approx(0.0625)  # the floor, 1.25 voxels, above the cap
     offset = (0.0125, 0.0125, 0.0125)
     cam, scene, poses, depths, observed = offset_room(offset)
     scores = {}
-    for name, cap, weight in (("before", 0.0, 1.0), ("default", 0.05, 1.0), ("low", 0.05, 0.05)):
+    for name, cap, weight, far_free in (
+        ("before", 0.0, 1.0, 1.0),
+        ("cap", 0.05, 1.0, 1.0),
+        ("low", 0.05, 0.05, 1.0),
+        ("default", 0.05, 1.0, 0.05),
+    ):
         config = dp.TsdfConfig()
         config.voxel_size_m = 0.05
         config.confirm_depth_max_m = cap
         config.unconfirmed_update_weight = weight
+        config.far_free_guess_weight = far_free
         _, mesh = fused_mesh(config, cam, poses, depths)
         scores[name] = score_mesh(scene, mesh["vertices"], mesh["triangles"], 0.05, observed)
     assert scores["before"].ghost_fraction > 0.003
-    assert scores["default"].ghost_fraction < 0.5 * scores["before"].ghost_fraction
+    assert scores["cap"].ghost_fraction < 0.5 * scores["before"].ghost_fraction
     assert scores["low"].ghost_fraction < 0.0005
-    for name in ("default", "low"):
+    assert scores["default"].ghost_fraction < 0.0005
+    for name in ("cap", "low", "default"):
         assert scores[name].completeness > scores["before"].completeness - 0.002
 
 
@@ -372,6 +381,8 @@ def test_confirm_settings_out_of_range_are_refused() -> None:
         ("confirm_depth_max_m", float("nan")),
         ("unconfirmed_update_weight", 0.0),
         ("unconfirmed_update_weight", 1.5),
+        ("far_free_guess_weight", 0.0),
+        ("far_free_guess_weight", 1.5),
     ):
         config = dp.TsdfConfig()
         setattr(config, name, bad)

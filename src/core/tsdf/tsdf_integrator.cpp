@@ -760,6 +760,10 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
   const float* confirm_depth_px = frame.confirm_depth.data();
   // A non-confirming update's weight factor (TsdfConfig::unconfirmed_update_weight).
   const float unconfirmed_weight = static_cast<float>(map->config().unconfirmed_update_weight);
+  // TsdfConfig::far_free_guess_weight: a guess's factor on a voxel seen far free, and a far-free
+  // update's on an unconfirmed voxel.
+  const float far_free_guess = static_cast<float>(map->config().far_free_guess_weight);
+  const float far_free_boost = 1.0f / far_free_guess;
   // The blocks are found (or allocated) first, so each block's integration can prefetch the
   // next block's voxels: blocks lie scattered in memory, where the hardware prefetcher does not
   // follow.
@@ -873,6 +877,11 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
         // Pass 3, the row's eight fusions at once (a plain loop the compiler vectorises; a
         // voxel that is not updated keeps its value through the selects).
         TsdfVoxel* row_voxels = &block->voxels[TsdfBlock::linear(0, y, z)];
+        // The row's far-free bits unpacked and packed outside the loop, which keeps it plain.
+        std::uint8_t& far_free_row =
+            block->far_free_rows[TsdfBlock::linear(0, y, z) / kTsdfBlockSide];
+        alignas(32) int seen_far_free[kTsdfBlockSide], far_free[kTsdfBlockSide];
+        for (int x = 0; x < kTsdfBlockSide; ++x) seen_far_free[x] = (far_free_row >> x) & 1;
         int updated = 0;
         for (int x = 0; x < kTsdfBlockSide; ++x) {
           const float z_axis = zc[x];
@@ -914,12 +923,24 @@ TsdfIntegrationStats DepthIntegrator::integrate(TsdfMap* map, const float* depth
           // Deeper than the confirm depth along the normal: the update fuses, at a lower weight,
           // but does not confirm the voxel (a slab's far side, which no frame may ever see).
           const bool confirms = !(in_band & (sdf < -confirm_depth[x]));
-          const TsdfVoxel fused =
-              map->fused(voxel, dn, confirms ? obs_w : obs_w * unconfirmed_weight, confirms);
+          // Far free: the ray went on more than mu past the voxel (or found no return). A guess
+          // on a voxel that reads free and was seen far free counts less, and far free counts
+          // more on a voxel only guessed so far: either way round, free space seen beats a guess
+          // (TsdfConfig::far_free_guess_weight).
+          far_free[x] = update & (sdf >= muf);
+          const bool seen_free = (seen_far_free[x] != 0) & (voxel.distance > 0.0f);
+          const float boost = (far_free[x] != 0) & (voxel.weight < 0.0f) ? far_free_boost : 1.0f;
+          const float factor =
+              confirms ? boost : unconfirmed_weight * (seen_free ? far_free_guess : 1.0f);
+          const TsdfVoxel fused = map->fused(voxel, dn, obs_w * factor, confirms);
           voxel.distance = update ? fused.distance : voxel.distance;
           voxel.weight = update ? fused.weight : voxel.weight;
           updated += update;
         }
+        unsigned far_free_bits = far_free_row;
+        for (int x = 0; x < kTsdfBlockSide; ++x)
+          far_free_bits |= static_cast<unsigned>(far_free[x]) << x;
+        far_free_row = static_cast<std::uint8_t>(far_free_bits);
         stats.voxels_updated += updated;
         touched |= updated != 0;
       }

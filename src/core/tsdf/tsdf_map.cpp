@@ -28,6 +28,9 @@ std::string TsdfConfig::inertSettings() const {
   } else if (unconfirmed_update_weight != defaults.unconfirmed_update_weight) {
     confirm_setting = "unconfirmed_update_weight";
     confirm_value = unconfirmed_update_weight;
+  } else if (far_free_guess_weight != defaults.far_free_guess_weight) {
+    confirm_setting = "far_free_guess_weight";
+    confirm_value = far_free_guess_weight;
   }
   const char* confirm_inert =
       !(confirm_depth_voxels > 0.0)
@@ -107,6 +110,8 @@ std::string TsdfConfig::validate() const {
   } else if (!(unconfirmed_update_weight > 0.0 && unconfirmed_update_weight <= 1.0)) {
     why << "unconfirmed_update_weight must be in (0, 1] (1 = as a confirming update), got "
         << unconfirmed_update_weight;
+  } else if (!(far_free_guess_weight > 0.0 && far_free_guess_weight <= 1.0)) {
+    why << "far_free_guess_weight must be in (0, 1] (1 = off), got " << far_free_guess_weight;
   } else if (!(incidence_window_radius_px >= 0 && incidence_window_radius_px <= 64)) {
     why << "incidence_window_radius_px must be in [0, 64] (0 = off), got "
         << incidence_window_radius_px;

@@ -38,6 +38,7 @@ TsdfConfig loadTsdfConfig(const ros::NodeHandle& pnh, ConfigErrorLog* errors) {
   readParam(pnh, "confirm_depth_voxels", &c.confirm_depth_voxels, errors);
   readParam(pnh, "confirm_depth_max_m", &c.confirm_depth_max_m, errors);
   readParam(pnh, "unconfirmed_update_weight", &c.unconfirmed_update_weight, errors);
+  readParam(pnh, "far_free_guess_weight", &c.far_free_guess_weight, errors);
   readParam(pnh, "incidence_window_radius_px", &c.incidence_window_radius_px, errors);
   readParam(pnh, "interpolate_depth", &c.interpolate_depth, errors);
   readParam(pnh, "carve_free_space", &c.carve_free_space, errors);

@@ -165,6 +165,7 @@ void TsdfRos::reconfigure(TsdfNodeletConfig& cfg, std::uint32_t) {
   next.confirm_depth_voxels = cfg.confirm_depth_voxels;
   next.confirm_depth_max_m = cfg.confirm_depth_max_m;
   next.unconfirmed_update_weight = cfg.unconfirmed_update_weight;
+  next.far_free_guess_weight = cfg.far_free_guess_weight;
   next.incidence_window_radius_px = cfg.incidence_window_radius_px;
   next.edge_guard_rad = cfg.edge_guard_rad;
   next.edge_guard_near_side_only = cfg.edge_guard_near_side_only;
