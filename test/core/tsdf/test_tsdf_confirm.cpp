@@ -248,22 +248,33 @@ TEST(TsdfConfirm, TheConfirmDepthIsCappedInMetresAboveAFloorInVoxels) {
   EXPECT_NE(c.inertSettings().find("confirm_depth_max_m"), std::string::npos);
 }
 
-TEST(TsdfConfirm, ConfigChecksTheUnconfirmedWeightAndNamesItInertWithoutConfirmation) {
-  TsdfConfig c;
-  EXPECT_EQ(c.unconfirmed_update_weight, 1.0);
-  for (const double bad : {0.0, -0.1, 1.01, std::nan(""), HUGE_VAL}) {
-    c.unconfirmed_update_weight = bad;
-    EXPECT_NE(c.validate().find("unconfirmed_update_weight"), std::string::npos) << bad;
+// The two weight factors of non-confirming updates: unconfirmed_update_weight (default 1) and
+// far_free_guess_weight (default 0.05), in (0, 1]; neither acts without the confirm rule or
+// without incidences.
+TEST(TsdfConfirm, ConfigChecksTheGuessWeightsAndNamesThemInertWithoutConfirmation) {
+  const struct {
+    const char* name;
+    double TsdfConfig::*member;
+    double default_value;
+  } factors[] = {{"unconfirmed_update_weight", &TsdfConfig::unconfirmed_update_weight, 1.0},
+                 {"far_free_guess_weight", &TsdfConfig::far_free_guess_weight, 0.05}};
+  for (const auto& factor : factors) {
+    TsdfConfig c;
+    EXPECT_EQ(c.*factor.member, factor.default_value) << factor.name;
+    for (const double bad : {0.0, -0.1, 1.01, std::nan(""), HUGE_VAL}) {
+      c.*factor.member = bad;
+      EXPECT_NE(c.validate().find(factor.name), std::string::npos) << factor.name << " " << bad;
+    }
+    c.*factor.member = 0.2;
+    EXPECT_EQ(c.validate(), "") << factor.name;
+    EXPECT_EQ(c.inertSettings(), "") << factor.name;
+    c.confirm_depth_voxels = 0.0;  // every update confirms: no guess, no unconfirmed voxel
+    EXPECT_NE(c.inertSettings().find(factor.name), std::string::npos);
+    c.confirm_depth_voxels = TsdfConfig().confirm_depth_voxels;
+    c.edge_guard_rad = 0.0;
+    c.grazing_reach_voxels = 0.0;  // no incidences: no update is deep along a normal
+    EXPECT_NE(c.inertSettings().find(factor.name), std::string::npos);
   }
-  c.unconfirmed_update_weight = 0.05;
-  EXPECT_EQ(c.validate(), "");
-  EXPECT_EQ(c.inertSettings(), "");
-  c.confirm_depth_voxels = 0.0;  // every update confirms: the weight never applies
-  EXPECT_NE(c.inertSettings().find("unconfirmed_update_weight"), std::string::npos);
-  c.confirm_depth_voxels = TsdfConfig().confirm_depth_voxels;
-  c.edge_guard_rad = 0.0;
-  c.grazing_reach_voxels = 0.0;  // no incidences: no update is deep along a normal
-  EXPECT_NE(c.inertSettings().find("unconfirmed_update_weight"), std::string::npos);
 }
 
 // Along the optical axis of a fronto-parallel wall (incidence 0, no rim near): a voxel a voxel
@@ -375,18 +386,4 @@ TEST(TsdfFarFree, AGuessOnAVoxelThatReadsInsideFusesAtFullWeight) {
   seeWallAt(&map, 1.0, 1);
   EXPECT_FLOAT_EQ(v->weight, 5.0f);
   EXPECT_NEAR(v->distance, (4.0 * inside - 0.06 / mu) / 5.0, 1e-4);
-}
-
-TEST(TsdfFarFree, ConfigChecksTheFactorAndNamesItInertWithoutConfirmation) {
-  TsdfConfig c;
-  EXPECT_EQ(c.far_free_guess_weight, 0.05);
-  for (const double bad : {0.0, -0.1, 1.01, std::nan(""), HUGE_VAL}) {
-    c.far_free_guess_weight = bad;
-    EXPECT_NE(c.validate().find("far_free_guess_weight"), std::string::npos) << bad;
-  }
-  c.far_free_guess_weight = 0.2;
-  EXPECT_EQ(c.validate(), "");
-  EXPECT_EQ(c.inertSettings(), "");
-  c.confirm_depth_voxels = 0.0;  // every update confirms: no guess, no unconfirmed voxel
-  EXPECT_NE(c.inertSettings().find("far_free_guess_weight"), std::string::npos);
 }
