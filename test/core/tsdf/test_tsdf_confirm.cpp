@@ -125,6 +125,17 @@ SlabCount tableTopSkirt(const TsdfConfig& c, const RoomFrames& frames) {
   return count;
 }
 
+/// A fronto-parallel wall `wall_m` along the optical axis of the benchmark camera at the origin,
+/// fused `frames` times into `map`.
+void seeWallAt(TsdfMap* map, double wall_m, int frames) {
+  const PinholeCamera camera = benchmarkCamera();
+  const std::vector<float> depth(static_cast<std::size_t>(camera.width) * camera.height,
+                                 static_cast<float>(wall_m));
+  for (int frame = 0; frame < frames; ++frame) {
+    DepthIntegrator().integrate(map, depth.data(), camera, Eigen::Isometry3d::Identity());
+  }
+}
+
 /// 2 cm voxels, the given confirm depth, the other settings' defaults.
 TsdfConfig withConfirmDepth(double confirm_depth_voxels) {
   TsdfConfig c;
@@ -288,12 +299,7 @@ TEST(TsdfConfirm, ANonConfirmingUpdateFusesAtTheLowerWeight) {
     c.confirm_depth_voxels = 2.5;
     c.unconfirmed_update_weight = scale;
     TsdfMap map(c);
-    const PinholeCamera camera = benchmarkCamera();
-    const std::vector<float> depth(static_cast<std::size_t>(camera.width) * camera.height, 1.0f);
-    const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    for (int frame = 0; frame < 2; ++frame) {
-      DepthIntegrator().integrate(&map, depth.data(), camera, pose);
-    }
+    seeWallAt(&map, 1.0, 2);
     const TsdfVoxel* near = map.voxel({0, 0, 51});  // 2 cm behind the wall at 1 m
     const TsdfVoxel* deep = map.voxel({0, 0, 53});  // 6 cm behind: deeper than 2.5 voxels
     ASSERT_NE(near, nullptr);
@@ -306,17 +312,6 @@ TEST(TsdfConfirm, ANonConfirmingUpdateFusesAtTheLowerWeight) {
 }
 
 namespace {
-
-/// A fronto-parallel wall `wall_m` along the optical axis of the benchmark camera at the origin,
-/// fused `frames` times into `map`.
-void seeWallAt(TsdfMap* map, double wall_m, int frames) {
-  const PinholeCamera camera = benchmarkCamera();
-  const std::vector<float> depth(static_cast<std::size_t>(camera.width) * camera.height,
-                                 static_cast<float>(wall_m));
-  for (int frame = 0; frame < frames; ++frame) {
-    DepthIntegrator().integrate(map, depth.data(), camera, Eigen::Isometry3d::Identity());
-  }
-}
 
 /// 2 cm voxels, mu 8 cm, the confirm depth 5 cm along the axis; the voxel watched is {0, 0, 53}
 /// (z 1.06 m): far free with the wall at 1.16 m (10 cm > mu in front), a non-confirming guess with
