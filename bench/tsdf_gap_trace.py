@@ -39,14 +39,14 @@ AXES = "xyz"
 
 
 def load_bench() -> Any:
-    """bench_tsdf_accuracy.py, beside this file, as a module (it is a script, not a package)."""
-    path = Path(__file__).resolve().parent / "bench_tsdf_accuracy.py"
-    spec = importlib.util.spec_from_file_location("bench_tsdf_accuracy", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    """bench_tsdf_accuracy.py, beside this file (a script, not a package: imported with its
+    folder on sys.path, as a script run from there has it)."""
+    folder = str(Path(__file__).resolve().parent)
+    if folder not in sys.path:
+        sys.path.insert(0, folder)
+    import bench_tsdf_accuracy
+
+    return bench_tsdf_accuracy
 
 
 def face_labels(q: np.ndarray, half: np.ndarray, voxel_m: float) -> list[str]:

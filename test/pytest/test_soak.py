@@ -3,25 +3,17 @@ ramp's verdicts and the table. No ROS, no timing."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "bench" / "soak.py"
-
 
 @pytest.fixture(scope="module")
-def soak() -> Any:
-    spec = importlib.util.spec_from_file_location("soak", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+def soak(bench_script: Callable[[str], Any]) -> Any:
+    return bench_script("soak")
 
 
 def result(soak: Any, rss: list[tuple[float, int]], name: str = "tsdf") -> Any:

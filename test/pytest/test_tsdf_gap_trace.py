@@ -3,25 +3,16 @@ case's frames are the accuracy benchmark's (ours only: Open3D is not installed f
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "bench" / "tsdf_gap_trace.py"
-
 
 @pytest.fixture(scope="module")
-def gap() -> Any:
-    spec = importlib.util.spec_from_file_location("tsdf_gap_trace", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+def gap(bench_script: Callable[[str], Any]) -> Any:
+    return bench_script("tsdf_gap_trace")
 
 
 def test_samples_are_labelled_with_the_nearest_part_and_box_edges(gap: Any) -> None:
