@@ -333,32 +333,26 @@ def run(
     legacy_native_lattice: bool = False,
     variants: Sequence[Settings] = ((),),
 ) -> list[Score]:
-    from downstream_perception.sim.depth_camera import DepthCamera
-    from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
-    from downstream_perception.tsdf_eval import observed_samples
+    from downstream_perception.sim.scenes import accuracy_scene
 
     chosen = integrators(edge_guards, open3d, legacy_native_lattice, variants)
-    cameras = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}
     scores = []
     for image in dict.fromkeys(image for image, _ in configs):
-        cam = scaled(cameras[image], camera_scale)
+        cam = scaled(camera(image), camera_scale)
         for scene_name in scenes:
-            # Seeds from the full lists' indices, so a subset gets the full run's frames.
-            si = list(ACCURACY_SCENES).index(scene_name)
             # Scene and cameras move together, so the images and the observed surface (moved
             # along) are the same at every offset: rendered once.
-            base, base_poses = accuracy_scene(scene_name, (0.0, 0.0, 0.0), frames)
-            clean = [cam.render(base, T) for T in base_poses]
-            base_observed = observed_samples(base, cam, base_poses, clean)
+            clean, base_observed = scene_frames(cam, scene_name, frames)
             for voxel in [v for i, v in configs if i == image]:
                 for fraction in offsets:
-                    oi = offset_index(fraction)
                     t0 = time.perf_counter()
                     offset = (fraction * voxel,) * 3
                     scene, poses = accuracy_scene(scene_name, offset, frames)
                     observed = base_observed + np.asarray(offset)
                     for noise in noises:
-                        depths, at = noisy_frames(clean, poses, noise, seed=case_seed(si, oi))
+                        depths, at = noisy_frames(
+                            clean, poses, noise, seed=scene_seed(scene_name, fraction)
+                        )
                         for name, integrate in chosen.items():
                             row = score_case(integrate, scene, cam, depths, at, voxel, observed)
                             scores.append(
@@ -373,6 +367,33 @@ def run(
                         f"{time.perf_counter() - t0:.1f} s"
                     )
     return scores
+
+
+def camera(image: str) -> Any:
+    """The benchmark's camera for `image` ("320x240" or "640x480")."""
+    from downstream_perception.sim.depth_camera import DepthCamera
+
+    return {"640x480": DepthCamera.vga, "320x240": DepthCamera}[image]()
+
+
+def scene_frames(cam: Any, scene_name: str, frames: int) -> tuple[list[np.ndarray], np.ndarray]:
+    """The scene's clean frames at lattice offset 0 and the surface they observed. Scene and
+    cameras move together, so the images (and the observed surface, moved along) are the same at
+    every offset."""
+    from downstream_perception.sim.scenes import accuracy_scene
+    from downstream_perception.tsdf_eval import observed_samples
+
+    base, base_poses = accuracy_scene(scene_name, (0.0, 0.0, 0.0), frames)
+    clean = [cam.render(base, T) for T in base_poses]
+    return clean, observed_samples(base, cam, base_poses, clean)
+
+
+def scene_seed(scene_name: str, fraction: float) -> int:
+    """A case's noise seed, from the full lists' indices (so a subset gets the full run's
+    frames)."""
+    from downstream_perception.sim.scenes import ACCURACY_SCENES
+
+    return case_seed(list(ACCURACY_SCENES).index(scene_name), offset_index(fraction))
 
 
 def case_seed(scene_index: int, offset_index: int) -> int:

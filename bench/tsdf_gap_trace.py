@@ -124,23 +124,6 @@ def gaps(labels: np.ndarray, near_a: np.ndarray, near_b: np.ndarray) -> list[Par
     return sorted(out, key=lambda g: (-g.lost, g.gained - g.lost, g.part))
 
 
-def case_frames(
-    bench: Any, scene_name: str, fraction: float, image: str, frames: int
-) -> tuple[Any, Any, list[np.ndarray], np.ndarray, int]:
-    """What bench_tsdf_accuracy.run builds for a case before moving it: the camera, the unmoved
-    scene, its clean frames, the observed samples, and the case's noise seed."""
-    from downstream_perception.sim.depth_camera import DepthCamera
-    from downstream_perception.sim.scenes import ACCURACY_SCENES, accuracy_scene
-    from downstream_perception.tsdf_eval import observed_samples
-
-    cam = {"640x480": DepthCamera.vga(), "320x240": DepthCamera()}[image]
-    base, base_poses = accuracy_scene(scene_name, (0.0, 0.0, 0.0), frames)
-    clean = [cam.render(base, T) for T in base_poses]
-    observed = observed_samples(base, cam, base_poses, clean)
-    seed = bench.case_seed(list(ACCURACY_SCENES).index(scene_name), bench.offset_index(fraction))
-    return cam, base, clean, observed, seed
-
-
 def trace(
     bench: Any,
     scene_name: str,
@@ -157,10 +140,12 @@ def trace(
     from downstream_perception.sim.scenes import accuracy_scene
     from downstream_perception.tsdf_eval import near_mesh
 
-    cam, base, clean, base_observed, seed = case_frames(bench, scene_name, fraction, image, frames)
+    cam = bench.camera(image)
+    clean, base_observed = bench.scene_frames(cam, scene_name, frames)
     offset = (fraction * voxel_m,) * 3
-    _, poses = accuracy_scene(scene_name, offset, frames)
+    scene, poses = accuracy_scene(scene_name, offset, frames)
     observed = base_observed + np.asarray(offset)
+    seed = bench.scene_seed(scene_name, fraction)
     depths, at = bench.noisy_frames(clean, poses, bench.NOISES[noise_index], seed=seed)
     integrate_a = bench.ours(settings=bench.parse_settings(ours))
     integrate_b = (
@@ -172,8 +157,7 @@ def trace(
     for integrate in (integrate_a, integrate_b):
         vertices, triangles = bench.weld(*integrate(depths, at, cam, voxel_m))
         near.append(near_mesh(observed, vertices, triangles, COMPLETENESS_RADIUS_M))
-    # Attributed on the unmoved scene: the samples moved with it.
-    labels = part_labels(base, base_observed, voxel_m)
+    labels = part_labels(scene, observed, voxel_m)
     completeness = {"a": float(near[0].mean()), "b": float(near[1].mean())}
     return completeness, gaps(labels, near[0], near[1])
 
